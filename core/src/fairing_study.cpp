@@ -1,0 +1,47 @@
+#include "posefair/core/fairing_study.hpp"
+
+#include <algorithm>
+
+#include "posefair/core/difference_operators.hpp"
+
+namespace posefair {
+namespace {
+
+FairingTracePoint measure(int k, const SyntheticMotion& motion, std::span<const Quat> q,
+                          std::span<const Vec3> p, int order) {
+  FairingTracePoint t;
+  t.iteration = k;
+  const std::size_t n = q.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double e_in = so3::dist(motion.noisy.orientation[i], q[i]);
+    t.mean_error_to_input += e_in / static_cast<double>(n);
+    t.max_error_to_input = std::max(t.max_error_to_input, e_in);
+    t.mean_error_to_truth += so3::dist(motion.truth.orientation[i], q[i]) / static_cast<double>(n);
+  }
+  const double dt = motion.noisy.time.size() > 1 ? motion.noisy.time[1] - motion.noisy.time[0] : 1.0;
+  const auto w2 = orientation_differences(q, 2);
+  for (const Vec3& w : w2) t.mean_angular_acceleration += 2.0 * w.norm() / static_cast<double>(w2.size()) / (dt * dt);
+  t.rotational_energy = rotational_energy(q, order);
+  if (!p.empty()) {
+    for (std::size_t i = 0; i < n; ++i)
+      t.mean_position_error_to_truth += (motion.truth.position[i] - p[i]).norm() / static_cast<double>(n);
+    const auto d2 = position_differences(p, 2);
+    for (const Vec3& d : d2) t.mean_acceleration += d.norm() / static_cast<double>(d2.size()) / (dt * dt);
+  }
+  return t;
+}
+
+}  // namespace
+
+std::vector<FairingTracePoint> trace_fairing(const SyntheticMotion& motion, const FairingParams& params) {
+  std::vector<FairingTracePoint> trace;
+  std::vector<Quat> q0 = motion.noisy.orientation;
+  so3::make_continuous(q0);
+  trace.push_back(measure(0, motion, q0, motion.noisy.position, params.order));
+  fair(motion.noisy, params, [&](int k, std::span<const Quat> q, std::span<const Vec3> p) {
+    trace.push_back(measure(k, motion, q, p, params.order));
+  });
+  return trace;
+}
+
+}  // namespace posefair
