@@ -44,4 +44,28 @@ std::vector<FairingTracePoint> trace_fairing(const SyntheticMotion& motion, cons
   return trace;
 }
 
+std::vector<FairingTracePoint> mean_trace(const SyntheticMotionSpec& spec, int seeds, const FairingParams& params) {
+  std::vector<FairingTracePoint> mean;
+  for (int s = 1; s <= seeds; ++s) {
+    SyntheticMotionSpec one = spec;
+    one.seed = static_cast<std::uint64_t>(s);
+    const auto t = trace_fairing(make_synthetic_motion(one), params);
+    // With finite bounds traces may differ in length: keep the common prefix.
+    if (mean.empty()) mean.resize(t.size());
+    if (t.size() < mean.size()) mean.resize(t.size());
+    const double w = 1.0 / seeds;
+    for (std::size_t k = 0; k < mean.size(); ++k) {
+      mean[k].iteration = t[k].iteration;
+      mean[k].mean_error_to_input += w * t[k].mean_error_to_input;
+      mean[k].mean_error_to_truth += w * t[k].mean_error_to_truth;
+      mean[k].max_error_to_input += w * t[k].max_error_to_input;
+      mean[k].mean_angular_acceleration += w * t[k].mean_angular_acceleration;
+      mean[k].mean_position_error_to_truth += w * t[k].mean_position_error_to_truth;
+      mean[k].mean_acceleration += w * t[k].mean_acceleration;
+      mean[k].rotational_energy += w * t[k].rotational_energy;
+    }
+  }
+  return mean;
+}
+
 }  // namespace posefair

@@ -8,28 +8,13 @@
 namespace posefair {
 namespace {
 
-// Mean of a trace quantity over seeds 1..5 at each iteration (unbounded: ε = ∞).
+// Mean over seeds 1..5 at each iteration (unbounded: ε = ∞), as docs/fairing.md plots it.
 std::vector<FairingTracePoint> mean_trace(int order, double lambda_r, int iterations) {
-  std::vector<FairingTracePoint> mean;
-  const int seeds = 5;
-  for (int s = 1; s <= seeds; ++s) {
-    SyntheticMotionSpec spec;
-    spec.seed = static_cast<std::uint64_t>(s);
-    FairingParams p;
-    p.order = order;
-    p.lambda_r = lambda_r;
-    p.max_iterations = iterations;
-    const auto t = trace_fairing(make_synthetic_motion(spec), p);
-    if (mean.empty()) mean.resize(t.size());
-    for (std::size_t k = 0; k < t.size(); ++k) {
-      mean[k].iteration = t[k].iteration;
-      mean[k].mean_error_to_input += t[k].mean_error_to_input / seeds;
-      mean[k].mean_error_to_truth += t[k].mean_error_to_truth / seeds;
-      mean[k].mean_angular_acceleration += t[k].mean_angular_acceleration / seeds;
-      mean[k].mean_acceleration += t[k].mean_acceleration / seeds;
-    }
-  }
-  return mean;
+  FairingParams p;
+  p.order = order;
+  p.lambda_r = lambda_r;
+  p.max_iterations = iterations;
+  return posefair::mean_trace(SyntheticMotionSpec{}, 5, p);
 }
 
 // Claim 1: "The average error of the third order algorithm converges within the range of

@@ -23,4 +23,7 @@ struct FairingTracePoint {
 // unbounded iteration) and returns iteration 0 (the input) and every accepted iteration.
 std::vector<FairingTracePoint> trace_fairing(const SyntheticMotion& motion, const FairingParams& params);
 
+// The trace averaged point by point over seeds 1 … seeds of `spec` (spec.seed is ignored).
+std::vector<FairingTracePoint> mean_trace(const SyntheticMotionSpec& spec, int seeds, const FairingParams& params);
+
 }  // namespace posefair

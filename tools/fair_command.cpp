@@ -1,0 +1,142 @@
+#include "fair_command.hpp"
+
+#include <cmath>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
+
+#include "exit_codes.hpp"
+#include "posefair/core/fairing.hpp"
+#include "posefair/drivers/pose_file.hpp"
+
+namespace posefair::tools {
+namespace {
+
+struct FairOptions {
+  std::string input;
+  std::string output;
+  std::optional<drivers::PoseFormat> format;
+  std::string joint;
+  bool skip_missing = false;
+  bool quiet = false;
+  FairingParams params;
+  double eps_r_rotation = std::numeric_limits<double>::infinity();  // physical angle, rad
+};
+
+double mean_rate_hz(const PoseSequence& s) {
+  if (s.size() < 2 || s.time.back() <= s.time.front()) return 0.0;
+  return static_cast<double>(s.size() - 1) / (s.time.back() - s.time.front());
+}
+
+int run_fair(FairOptions o) {
+  {
+    std::ifstream probe(o.input);
+    if (!probe) {
+      std::cerr << "posefair fair: cannot open " << o.input << ": " << std::strerror(errno) << "\n";
+      return kExitNoInput;
+    }
+  }
+  drivers::ReadOptions ro;
+  ro.format = o.format;
+  ro.bvh_joint = o.joint;
+  ro.skip_missing = o.skip_missing;
+  // The user's bound is a physical rotation angle; the paper's eq. 20 bounds dist on S³ (half).
+  o.params.epsilon_r = o.eps_r_rotation / 2.0;
+
+  std::optional<drivers::PoseFile> read;
+  try {
+    read.emplace(drivers::read_pose_file(o.input, ro));
+  } catch (const drivers::PoseFileError& e) {
+    std::cerr << "posefair fair: " << e.what() << "\n";
+    return kExitDataErr;
+  }
+  const drivers::PoseFile& file = *read;
+  for (const std::string& w : file.warnings()) std::cerr << "posefair fair: warning: " << w << "\n";
+  const PoseSequence& in = file.poses();
+  try {
+    const FairingResult r = fair(in, o.params);
+    try {
+      drivers::write_pose_file(o.output, file, r.poses);
+    } catch (const drivers::PoseFileError& e) {
+      std::cerr << "posefair fair: " << e.what() << "\n";
+      return kExitCantCreate;
+    }
+    if (!o.quiet) {
+      const int m = o.params.order;
+      std::printf("input    %s: %zu samples, %s, %s, %.1f Hz mean rate", o.input.c_str(), in.size(),
+                  std::string(drivers::to_string(file.format())).c_str(),
+                  in.has_position() ? "orientation + position" : "orientation only", mean_rate_hz(in));
+      if (file.skipped_rows() > 0) std::printf(", %zu rows without orientation skipped", file.skipped_rows());
+      std::printf("\nfairing  m=%d, %s operators, lambda_r=%g lambda_t=%g, eps_r=%g rad eps_t=%g, cap %d\n", m,
+                  o.params.variant == OperatorVariant::Printed ? "printed" : "corrected", o.params.lambda_r,
+                  o.params.lambda_t, o.eps_r_rotation, o.params.epsilon_t, o.params.max_iterations);
+      std::printf("stopped  after %d iterations: %s\n", r.iterations, std::string(to_string(r.stop)).c_str());
+      std::printf("energy   E%d_r %.6g -> %.6g (x%.3g)", m, r.rotational_energy_before, r.rotational_energy_after,
+                  r.rotational_energy_before > 0 ? r.rotational_energy_after / r.rotational_energy_before : 1.0);
+      if (in.has_position())
+        std::printf("   E%d_t %.6g -> %.6g (x%.3g)", m, r.translational_energy_before, r.translational_energy_after,
+                    r.translational_energy_before > 0 ? r.translational_energy_after / r.translational_energy_before
+                                                      : 1.0);
+      std::printf("\nmax dev  rotation %.6g rad (%.4g deg)", 2.0 * r.max_dist_r,
+                  2.0 * r.max_dist_r * 180.0 / std::numbers::pi);
+      if (in.has_position()) std::printf(", position %.6g", r.max_deviation_t);
+      std::printf("\nwrote    %s\n", o.output.c_str());
+    }
+    return kExitOk;
+  } catch (const std::invalid_argument& e) {
+    // Too few samples for the order (the parameters were checked by the command line).
+    std::cerr << "posefair fair: " << o.input << ": " << e.what() << "\n";
+    return kExitDataErr;
+  }
+}
+
+}  // namespace
+
+void add_fair_command(CLI::App& app, int& exit_code) {
+  auto o = std::make_shared<FairOptions>();
+  auto* cmd = app.add_subcommand("fair", "Batch Lee & Shin motion fairing of a pose file (TUM, CSV, BVH joint)");
+  cmd->add_option("input", o->input, "pose file to read")->required();
+  cmd->add_option("-o,--output", o->output, "file to write, in the input's format (written atomically)")->required();
+  const std::map<std::string, drivers::PoseFormat> formats{
+      {"tum", drivers::PoseFormat::Tum}, {"csv", drivers::PoseFormat::Csv}, {"bvh", drivers::PoseFormat::Bvh}};
+  cmd->add_option("--format", o->format, "input format (default: by extension .txt/.tum, .csv, .bvh)")
+      ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
+  cmd->add_option("--joint", o->joint, "BVH: the joint to fair");
+  cmd->add_flag("--skip-missing", o->skip_missing, "CSV: drop rows whose quaternion is nan or empty");
+  cmd->add_option("-m,--order", o->params.order, "fairing order m (2: constant angular velocity, 3: constant acceleration)")
+      ->check(CLI::IsMember({2, 3}))
+      ->capture_default_str();
+  cmd->add_option("--lambda-r", o->params.lambda_r, "rotational damping (slerp factor) in (0, 1]")
+      ->check(CLI::Range(1e-9, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--lambda-t", o->params.lambda_t, "translational damping in (0, 1]")
+      ->check(CLI::Range(1e-9, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--eps-r", o->eps_r_rotation,
+                  "bound on each output's rotation from its measurement: physical angle, radians (default: none)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--eps-t", o->params.epsilon_t, "bound on each output's position offset, in the file's units (default: none)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("-n,--iterations", o->params.max_iterations, "cap on fairing sweeps")
+      ->check(CLI::Range(0, 100000000))
+      ->capture_default_str();
+  cmd->add_option("--step-tolerance", o->params.step_tolerance,
+                  "stop early when no sample moves more than this in a sweep (0: never)")
+      ->check(CLI::NonNegativeNumber);
+  const std::map<std::string, OperatorVariant> variants{{"corrected", OperatorVariant::Corrected},
+                                                        {"printed", OperatorVariant::Printed}};
+  cmd->add_option("--variant", o->params.variant, "rotation operators: corrected (default) or printed (the paper's as printed)")
+      ->transform(CLI::CheckedTransformer(variants, CLI::ignore_case));
+  cmd->add_flag("-q,--quiet", o->quiet, "print nothing on success");
+  cmd->callback([o, &exit_code] { exit_code = run_fair(*o); });
+}
+
+}  // namespace posefair::tools

@@ -1,0 +1,114 @@
+#!/usr/bin/python3
+"""Plots for docs/fairing.md from `posefair reproduce lee-shin` output.
+
+    build/tools/posefair reproduce lee-shin -o build/lee-shin-section6.csv
+    /usr/bin/python3 tools/plot_fairing.py build/lee-shin-section6.csv docs/img
+
+Needs python3-matplotlib (tools/setup-debian.sh --plots).
+"""
+import csv
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def load(path):
+    runs = defaultdict(lambda: defaultdict(list))
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            r = runs[row["run"]]
+            for k, v in row.items():
+                if k in ("run", "variant"):
+                    continue
+                r[k].append(float(v))
+    return runs
+
+
+def save(fig, out, name):
+    fig.tight_layout()
+    fig.savefig(out / name, dpi=110)
+    plt.close(fig)
+    print("wrote", out / name)
+
+
+def main():
+    runs = load(sys.argv[1])
+    out = Path(sys.argv[2])
+    out.mkdir(parents=True, exist_ok=True)
+    perturbation = 0.1
+
+    # Figure 2: average error, m = 2 vs m = 3, λ_r = 0.1, against input and against truth.
+    fig, ax = plt.subplots(1, 2, figsize=(10, 3.8), sharey=True)
+    for name, style in (("m2-l0.1", "C0"), ("m3-l0.1", "C1")):
+        r = runs[name]
+        ax[0].plot(r["iteration"], r["mean_error_to_input"], style, label=name.replace("-l", ", λr="))
+        ax[1].plot(r["iteration"], r["mean_error_to_truth"], style, label=name.replace("-l", ", λr="))
+    for a, title in zip(ax, ("to the noisy input (paper's Fig. 2)", "to the clean truth")):
+        a.axhline(perturbation, color="gray", ls=":", label="perturbation bound 0.1")
+        a.set_xscale("symlog", linthresh=10)
+        a.set_xlim(left=0)
+        a.set_xlabel("iteration")
+        a.set_title("mean error " + title)
+        a.legend()
+    ax[0].set_ylabel("mean dist on S³ (rad)")
+    save(fig, out, "fairing-error-m2-m3.png")
+
+    # Figure 3: damping, m = 3, λ_r = 0.1, 0.2, 0.3; right: the same against λ_r·k.
+    fig, ax = plt.subplots(1, 2, figsize=(10, 3.8), sharey=True)
+    for i, name in enumerate(("m3-l0.1", "m3-l0.2", "m3-l0.3")):
+        r = runs[name]
+        lam = r["lambda_r"][0]
+        c = f"C{i}"
+        ax[0].plot(r["iteration"], r["mean_error_to_truth"], c, label=f"λr={lam:.1f} to truth")
+        ax[0].plot(r["iteration"], r["mean_error_to_input"], c, ls="--", label=f"λr={lam:.1f} to input")
+        ax[1].plot([lam * k for k in r["iteration"]], r["mean_error_to_truth"], c, ls=("-", "--", ":")[i], label=f"λr={lam:.1f}")
+    ax[0].set_xscale("symlog", linthresh=10)
+    ax[0].set_xlim(left=0)
+    ax[0].set_xlabel("iteration")
+    ax[0].set_title("m = 3, damping (paper's Fig. 3)")
+    ax[1].set_xscale("symlog", linthresh=1)
+    ax[1].set_xlim(0, 100)
+    ax[1].set_xlabel("λr × iteration")
+    ax[1].set_title("error to truth against λr × iteration")
+    ax[0].set_ylabel("mean dist on S³ (rad)")
+    for a in ax:
+        a.legend(fontsize=8)
+    save(fig, out, "fairing-damping.png")
+
+    # Figures 4 and 5: acceleration and angular acceleration against iteration.
+    fig, ax = plt.subplots(1, 2, figsize=(10, 3.8))
+    for name in ("m2-l0.1", "m3-l0.1"):
+        r = runs[name]
+        ax[0].plot(r["iteration"][:101], r["mean_acceleration"][:101], label=name.replace("-l", ", λr="))
+        ax[1].plot(r["iteration"][:101], r["mean_angular_acceleration"][:101], label=name.replace("-l", ", λr="))
+    ax[0].set_title("translational acceleration (Fig. 4), λt = 0.5")
+    ax[0].set_ylabel("mean ‖D²p‖/Δ² (mm/s²)")
+    ax[1].set_title("angular acceleration (Fig. 5)")
+    ax[1].set_ylabel("mean 2‖W²q‖/Δ² (rad/s²)")
+    for a in ax:
+        a.set_yscale("log")
+        a.set_xlabel("iteration")
+        a.legend()
+    save(fig, out, "fairing-acceleration.png")
+
+    # Printed vs corrected operators.
+    fig, ax = plt.subplots(figsize=(6, 3.8))
+    for name in ("m2-l0.1", "m2-l0.1-printed", "m3-l0.1", "m3-l0.1-printed"):
+        r = runs[name]
+        ax.plot(r["iteration"], r["mean_error_to_truth"], label=name)
+    ax.set_xscale("symlog", linthresh=10)
+    ax.set_xlim(left=0)
+    ax.set_xlabel("iteration")
+    ax.set_ylabel("mean dist to truth (rad)")
+    ax.set_title("corrected vs printed operators, λr = 0.1")
+    ax.legend()
+    save(fig, out, "fairing-variants.png")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package posefair needs to build, test and benchmark.
+# Idempotent: when everything is present it only checks and prints nothing.
+#   tools/setup-debian.sh           build + test dependencies
+#   tools/setup-debian.sh --plots   also what tools/plot_*.py need (matplotlib)
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libeigen3-dev          # core math
+  googletest libgtest-dev libgmock-dev  # tests
+  libbenchmark-dev       # benchmarks
+  libcli11-dev           # the posefair command line
+)
+if [[ "${1:-}" == "--plots" ]]; then
+  packages+=(python3 python3-matplotlib python3-numpy)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+[[ ${#missing[@]} -eq 0 ]] && exit 0
+
+echo "setup: installing ${missing[*]}" >&2
+if [[ $(id -u) -eq 0 ]]; then
+  sudo=()
+elif command -v sudo >/dev/null 2>&1; then
+  sudo=(sudo)
+else
+  echo "setup: need root (or sudo) to install: ${missing[*]}" >&2
+  exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+if ! "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/tmp/posefair-apt.log 2>&1; then
+  # A fresh machine has no package lists yet: fetch them once and try again.
+  "${sudo[@]}" apt-get update -qq >>/tmp/posefair-apt.log 2>&1 || true
+  if ! "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >>/tmp/posefair-apt.log 2>&1; then
+    echo "setup: could not install some of: ${missing[*]}" >&2
+    for p in "${missing[@]}"; do
+      apt-cache policy "$p" 2>/dev/null | grep -q "Candidate: (none)" && echo "setup:   no installable candidate for '$p'" >&2
+    done
+    echo "setup: apt-get output is in /tmp/posefair-apt.log" >&2
+    tail -n 5 /tmp/posefair-apt.log >&2
+    exit 1
+  fi
+fi
