@@ -1,0 +1,62 @@
+#pragma once
+// What the engine lets in. Every sample is checked before it reaches a fairing window:
+//   - NaN/Inf anywhere, or a zero quaternion: rejected;
+//   - |‖q‖ − 1| ≤ unit_tolerance: renormalised (counted); beyond it: rejected;
+//   - time not after the last accepted sample's: dropped (repeated or out of order; an
+//     older sample cannot be placed in a window that has moved on);
+//   - time more than gap_threshold after the last accepted sample: accepted, and the window
+//     must restart (the operators assume evenly spaced samples).
+// Sample times may jitter: the fairing operators treat consecutive samples as evenly spaced.
+#include <cstdint>
+#include <limits>
+
+#include "posefair/core/sample.hpp"
+
+namespace posefair {
+
+struct GateConfig {
+  double unit_tolerance = 0.01;
+  double gap_threshold = 0.25;  // seconds
+};
+
+enum class GateVerdict {
+  Accept,
+  AcceptAfterGap,     // accept, but restart the window first
+  RejectNonFinite,
+  RejectZero,
+  RejectNonUnit,
+  DropRepeated,       // same time as the last accepted sample
+  DropOutOfOrder,     // older than the last accepted sample
+};
+
+struct GateCounters {
+  std::uint64_t accepted = 0;
+  std::uint64_t renormalised = 0;
+  std::uint64_t rejected_non_finite = 0;
+  std::uint64_t rejected_zero = 0;
+  std::uint64_t rejected_non_unit = 0;
+  std::uint64_t dropped_repeated = 0;
+  std::uint64_t dropped_out_of_order = 0;
+  std::uint64_t gaps = 0;
+
+  std::uint64_t rejected() const { return rejected_non_finite + rejected_zero + rejected_non_unit; }
+  std::uint64_t dropped() const { return dropped_repeated + dropped_out_of_order; }
+};
+
+class SampleGate {
+ public:
+  explicit SampleGate(const GateConfig& config = {});
+  // Checks s; on acceptance its orientation is normalised in place.
+  GateVerdict check(Sample& s);
+  // Forget the last time (a new stream), keep the counters.
+  void restart() { last_time_ = -std::numeric_limits<double>::infinity(); }
+  const GateCounters& counters() const { return counters_; }
+  const GateConfig& config() const { return config_; }
+
+ private:
+  GateConfig config_;
+  GateCounters counters_;
+  double last_time_ = -std::numeric_limits<double>::infinity();
+};
+
+}  // namespace posefair

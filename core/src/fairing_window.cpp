@@ -1,0 +1,333 @@
+#include "posefair/core/fairing_window.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+namespace posefair {
+namespace {
+
+// Moves x onto the ball of radius eps around z (distance on S³ for rotations) if it is outside.
+// The radius is shrunk by a relative 1e-9 so rounding cannot carry the result past eps.
+bool project_rotation(const Quat& z, Quat& x, double eps) {
+  const Vec3 v = so3::log(z.conjugate() * x);
+  const double r = v.norm();
+  const double limit = eps * (1.0 - 1e-9);
+  if (r <= limit) return false;
+  x = so3::aligned_to((z * so3::exp(v * (limit / r))).normalized(), x);
+  return true;
+}
+
+bool project_position(const Vec3& z, Vec3& p, double eps) {
+  const Vec3 d = p - z;
+  const double r = d.norm();
+  const double limit = eps * (1.0 - 1e-9);
+  if (r <= limit) return false;
+  p = z + d * (limit / r);
+  return true;
+}
+
+// In place: v (length len) -> D v (length len-1), the forward difference.
+void difference(std::span<Vec3> v, int len) {
+  for (int i = 0; i + 1 < len; ++i) v[static_cast<std::size_t>(i)] = v[static_cast<std::size_t>(i + 1)] - v[static_cast<std::size_t>(i)];
+}
+
+// In place: v (length len) -> Dᵀ v (length len+1), the adjoint of the forward difference.
+void difference_adjoint(std::span<Vec3> v, int len) {
+  for (int i = len; i >= 0; --i) {
+    const Vec3 prev = i > 0 ? v[static_cast<std::size_t>(i - 1)] : Vec3::Zero();
+    const Vec3 here = i < len ? v[static_cast<std::size_t>(i)] : Vec3::Zero();
+    v[static_cast<std::size_t>(i)] = prev - here;
+  }
+}
+
+}  // namespace
+
+void validate(const WindowConfig& c) {
+  auto bad = [](const std::string& what) { throw std::invalid_argument(what); };
+  if (c.order != 2 && c.order != 3) bad("order must be 2 or 3, got " + std::to_string(c.order));
+  if (c.window < c.order + 1 || c.window > 4096)
+    bad("window must hold " + std::to_string(c.order + 1) + " to 4096 samples for order " +
+        std::to_string(c.order) + ", got " + std::to_string(c.window));
+  if (c.lag < 0 || c.lag >= c.window)
+    bad("lag must be in [0, window-1] = [0, " + std::to_string(c.window - 1) + "], got " + std::to_string(c.lag));
+  if (c.iterations < 0 || c.iterations > 1000) bad("iterations must be in [0, 1000], got " + std::to_string(c.iterations));
+  if (!(c.smoothing_r >= 0.0) || !std::isfinite(c.smoothing_r)) bad("smoothing_r must be finite and >= 0");
+  if (!(c.smoothing_t >= 0.0) || !std::isfinite(c.smoothing_t)) bad("smoothing_t must be finite and >= 0");
+  if (!(c.continuity >= 0.0) || !std::isfinite(c.continuity)) bad("continuity must be finite and >= 0");
+  if (!(c.lambda_r > 0.0 && c.lambda_r <= 1.0)) bad("lambda_r must be in (0, 1]");
+  if (!(c.lambda_t > 0.0 && c.lambda_t <= 1.0)) bad("lambda_t must be in (0, 1]");
+  if (!(c.epsilon_r > 0.0)) bad("epsilon_r must be positive");
+  if (!(c.epsilon_t > 0.0)) bad("epsilon_t must be positive");
+  if (c.bound == BoundPolicy::Window && c.solver == WindowSolver::Linear)
+    bad("the window bound policy needs an iterative solver (gauss-newton or sweeps); linear solves in closed form");
+}
+
+double smoothing_for_cutoff(double cutoff_hz, double rate_hz, int order) {
+  if (!(cutoff_hz > 0.0 && rate_hz > 0.0 && cutoff_hz < rate_hz / 2.0))
+    throw std::invalid_argument("the cutoff must be positive and below half the sample rate");
+  const double s = 2.0 * std::sin(std::numbers::pi * cutoff_hz / rate_hz);
+  return std::pow(s, -2.0 * order);
+}
+
+FairingWindow::FairingWindow(const WindowConfig& config) : config_(config), gate_(config.gate) {
+  validate(config);
+  const auto w = static_cast<std::size_t>(config.window);
+  samples_.resize(w);
+  z_.resize(w);
+  x_.resize(w);
+  zeta_.resize(w);
+  est_.resize(w);
+  c_.resize(w);
+  y_.resize(w);
+  zp_.resize(w);
+  xp_.resize(w);
+  yp_.resize(w);
+  e_.resize(w);
+  u_.resize(w);
+  w_.resize(w + 1);
+  rhs_.resize(w);
+  target_.resize(w);
+  diag_.resize(w);
+  if (config.solver != WindowSolver::DampedSweeps) {
+    // One factorisation per fill level n; samples with index < n-1-L have been emitted.
+    factors_r_.resize(w + 1);
+    factors_t_.resize(w + 1);
+    for (int n = 1; n <= config.window; ++n) {
+      for (int i = 0; i < n; ++i) diag_[static_cast<std::size_t>(i)] = 1.0 + (i < n - 1 - config.lag ? config.continuity : 0.0);
+      factors_r_[static_cast<std::size_t>(n)] = make_smoothing_system(n, config.order, config.smoothing_r, std::span(diag_).first(static_cast<std::size_t>(n)));
+      factors_t_[static_cast<std::size_t>(n)] = make_smoothing_system(n, config.order, config.smoothing_t, std::span(diag_).first(static_cast<std::size_t>(n)));
+    }
+  }
+}
+
+std::size_t FairingWindow::memory_bytes() const {
+  std::size_t bytes = sizeof(*this);
+  bytes += samples_.capacity() * sizeof(Sample);
+  bytes += (z_.capacity() + x_.capacity() + y_.capacity() + target_.capacity()) * sizeof(Quat);
+  bytes += (zeta_.capacity() + est_.capacity() + c_.capacity()) * sizeof(Vec3);
+  bytes += (zp_.capacity() + xp_.capacity() + yp_.capacity() + e_.capacity() + u_.capacity() + w_.capacity() +
+            rhs_.capacity()) * sizeof(Vec3);
+  bytes += diag_.capacity() * sizeof(double);
+  for (const auto* set : {&factors_r_, &factors_t_}) {
+    bytes += set->capacity() * sizeof(BandedCholesky);
+    for (const BandedCholesky& f : *set) bytes += static_cast<std::size_t>(f.size() * (f.bandwidth() + 1)) * sizeof(double);
+  }
+  return bytes;
+}
+
+int FairingWindow::first_unemitted() const { return std::max(0, n_ - config_.lag); }
+
+FairedPose FairingWindow::emit(int index) {
+  const auto k = static_cast<std::size_t>(index);
+  Quat q;
+  bool clamped = false;
+  if (config_.solver == WindowSolver::Linear) {
+    // x = z exp(e): the ε projection is a clamp of ‖e‖ (dist(z, x) = ‖e‖ for ‖e‖ ≤ π/2).
+    Vec3 e = est_[k];
+    const double r = e.norm(), limit = std::min(config_.epsilon_r, std::numbers::pi / 2) * (1.0 - 1e-9);
+    if (r > limit) {
+      e *= limit / r;
+      clamped = true;
+    }
+    c_[k] = e;
+    q = (z_[k] * so3::exp(e)).normalized();
+  } else {
+    q = x_[k];
+    clamped = project_rotation(z_[k], q, config_.epsilon_r);
+  }
+  Vec3 p = xp_[k];
+  if (positions_) clamped = project_position(zp_[k], p, config_.epsilon_t) || clamped;
+  if (clamped) ++counters_.clamped;
+  y_[k] = q;
+  yp_[k] = p;
+  ++counters_.emitted;
+  const Sample& s = samples_[k];
+  FairedPose out;
+  out.stream_id = s.stream_id;
+  out.sequence = s.sequence;
+  out.time = s.time;
+  out.orientation = q;
+  out.position = positions_ ? p : Vec3::Zero();
+  out.measured = s.orientation;
+  out.measured_position = s.position;
+  out.flags = s.flags;
+  return out;
+}
+
+int FairingWindow::emit_pending(std::span<FairedPose> out) {
+  int count = 0;
+  for (int i = first_unemitted(); i < n_; ++i) out[static_cast<std::size_t>(count++)] = emit(i);
+  n_ = 0;
+  return count;
+}
+
+int FairingWindow::flush(std::span<FairedPose> out) { return emit_pending(out); }
+
+int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
+  Sample s = sample;
+  const GateVerdict verdict = gate_.check(s);
+  if (verdict != GateVerdict::Accept && verdict != GateVerdict::AcceptAfterGap) return 0;
+  int count = 0;
+  // A gap, or a change between streams with and without positions, starts a new window.
+  if (n_ > 0 && (verdict == GateVerdict::AcceptAfterGap || s.has_position() != positions_)) {
+    count = emit_pending(out);
+    ++counters_.restarts;
+  }
+  append(s);
+  solve();
+  const int k = n_ - 1 - config_.lag;
+  if (k >= 0) out[static_cast<std::size_t>(count++)] = emit(k);
+  return count;
+}
+
+void FairingWindow::append(const Sample& s) {
+  if (n_ == 0) positions_ = s.has_position();
+  if (n_ == config_.window) {
+    // Slide: drop the oldest (emitted long ago). W moves of a few dozen bytes each.
+    std::move(samples_.begin() + 1, samples_.end(), samples_.begin());
+    std::move(z_.begin() + 1, z_.end(), z_.begin());
+    if (config_.solver == WindowSolver::Linear) {
+      std::move(zeta_.begin() + 1, zeta_.end(), zeta_.begin());
+      std::move(c_.begin() + 1, c_.end(), c_.begin());
+    } else {
+      std::move(x_.begin() + 1, x_.end(), x_.begin());
+      std::move(y_.begin() + 1, y_.end(), y_.begin());
+    }
+    if (positions_) {
+      std::move(zp_.begin() + 1, zp_.end(), zp_.begin());
+      std::move(xp_.begin() + 1, xp_.end(), xp_.begin());
+      std::move(yp_.begin() + 1, yp_.end(), yp_.begin());
+    }
+    --n_;
+  }
+  const auto k = static_cast<std::size_t>(n_);
+  samples_[k] = s;
+  Quat z = s.orientation;
+  if (n_ == 0) {
+    if (z.w() < 0.0) z.coeffs() = -z.coeffs();
+  } else {
+    z = so3::aligned_to(z, z_[k - 1]);
+  }
+  z_[k] = z;
+  if (config_.solver == WindowSolver::Linear) {
+    if (n_ >= 1) zeta_[k - 1] = so3::log(z_[k - 1].conjugate() * z);
+    if (positions_) zp_[k] = s.position;
+    ++n_;
+    return;
+  }
+  // Warm start: the previous window's estimates stay; the new sample starts from the
+  // constant-velocity prediction of the estimates before it (its measurement if too few).
+  if (n_ >= 2) {
+    const Quat& a = x_[k - 2];
+    const Quat& b = x_[k - 1];
+    x_[k] = so3::aligned_to((b * (a.conjugate() * b)).normalized(), z);
+  } else {
+    x_[k] = z;
+  }
+  if (positions_) {
+    zp_[k] = s.position;
+    xp_[k] = n_ >= 2 ? Vec3(2.0 * xp_[k - 1] - xp_[k - 2]) : s.position;
+  }
+  ++n_;
+}
+
+void FairingWindow::solve() {
+  if (config_.solver == WindowSolver::Linear) {
+    linear_rotation(factors_r_[static_cast<std::size_t>(n_)]);
+    if (positions_) solve_positions(factors_t_[static_cast<std::size_t>(n_)]);
+  } else if (config_.solver == WindowSolver::GaussNewton) {
+    for (int it = 0; it < config_.iterations; ++it) {
+      gauss_newton_rotation(factors_r_[static_cast<std::size_t>(n_)]);
+      if (config_.bound == BoundPolicy::Window) bound_window();
+    }
+    if (positions_) {
+      solve_positions(factors_t_[static_cast<std::size_t>(n_)]);
+      if (config_.bound == BoundPolicy::Window) bound_window();
+    }
+  } else {
+    sweeps();
+  }
+}
+
+// rhs -= μ (D^m)ᵀ D^{m-1} w1, where w1 (in w_, n-1 entries) is W¹ of the linearisation point:
+// the gradient of μ‖W^m x‖² with W^m x = D^{m-1} W¹x and W¹ linear in the correction.
+void FairingWindow::smoothness_gradient(std::span<const Vec3> w1) {
+  const int n = n_, m = config_.order;
+  if (w1.data() != w_.data()) std::copy(w1.begin(), w1.begin() + (n - 1), w_.begin());
+  int len = n - 1;
+  for (int p = 1; p < m; ++p) difference(w_, len--);
+  for (int p = 0; p < m; ++p) difference_adjoint(w_, len++);
+  for (int i = 0; i < n; ++i) rhs_[static_cast<std::size_t>(i)] -= config_.smoothing_r * w_[static_cast<std::size_t>(i)];
+}
+
+void FairingWindow::linear_rotation(const BandedCholesky& a) {
+  const int n = n_;
+  const int emitted = n - 1 - config_.lag;
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    rhs_[k] = config_.continuity > 0.0 && i < emitted ? Vec3(config_.continuity * c_[k]) : Vec3::Zero();
+  }
+  if (n > config_.order && config_.smoothing_r > 0.0) smoothness_gradient(std::span<const Vec3>(zeta_).first(static_cast<std::size_t>(n - 1)));
+  a.solve(std::span(rhs_).first(static_cast<std::size_t>(n)));
+  std::copy(rhs_.begin(), rhs_.begin() + n, est_.begin());
+}
+
+void FairingWindow::gauss_newton_rotation(const BandedCholesky& a) {
+  const int n = n_;
+  const int m = config_.order;
+  const double mu = config_.smoothing_r;
+  const double kappa = config_.continuity;
+  const int emitted = n - 1 - config_.lag;  // indices below this were emitted
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    Vec3 g = so3::log(z_[k].conjugate() * x_[k]);  // data residual
+    if (kappa > 0.0 && i < emitted) g += kappa * so3::log(y_[k].conjugate() * x_[k]);
+    rhs_[k] = -g;
+  }
+  if (n > m && mu > 0.0) {
+    for (int j = 0; j + 1 < n; ++j) w_[static_cast<std::size_t>(j)] = so3::log(x_[static_cast<std::size_t>(j)].conjugate() * x_[static_cast<std::size_t>(j + 1)]);
+    smoothness_gradient(w_);
+  }
+  a.solve(std::span(rhs_).first(static_cast<std::size_t>(n)));
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    x_[k] = (x_[k] * so3::exp(rhs_[k])).normalized();
+  }
+}
+
+void FairingWindow::solve_positions(const BandedCholesky& a) {
+  // Linear: (I + κE + μ (D^m)ᵀD^m) p = z + κ E y, solved exactly.
+  const int emitted = n_ - 1 - config_.lag;
+  for (int i = 0; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    rhs_[k] = zp_[k];
+    if (config_.continuity > 0.0 && i < emitted) rhs_[k] += config_.continuity * yp_[k];
+  }
+  a.solve(std::span(rhs_).first(static_cast<std::size_t>(n_)));
+  for (int i = 0; i < n_; ++i) xp_[static_cast<std::size_t>(i)] = rhs_[static_cast<std::size_t>(i)];
+}
+
+void FairingWindow::sweeps() {
+  const int m = config_.order;
+  if (n_ < min_samples_for_order(m)) return;
+  const auto n = static_cast<std::size_t>(n_);
+  for (int it = 0; it < config_.iterations; ++it) {
+    damped_rotation_sweep(m, config_.variant, config_.lambda_r, std::span(x_).first(n), std::span(u_).first(n - 1),
+                          std::span(target_).first(n));
+    if (positions_) damped_position_sweep(m, config_.lambda_t, std::span(xp_).first(n), std::span(e_).first(n));
+    if (config_.bound == BoundPolicy::Window) bound_window();
+  }
+}
+
+void FairingWindow::bound_window() {
+  for (int i = 0; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    project_rotation(z_[k], x_[k], config_.epsilon_r);
+    if (positions_) project_position(zp_[k], xp_[k], config_.epsilon_t);
+  }
+}
+
+}  // namespace posefair

@@ -1,0 +1,52 @@
+#include "posefair/core/sample_gate.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace posefair {
+
+SampleGate::SampleGate(const GateConfig& config) : config_(config) {
+  if (!(config.unit_tolerance >= 0.0 && config.unit_tolerance < 1.0))
+    throw std::invalid_argument("unit_tolerance must be in [0, 1)");
+  if (!(config.gap_threshold > 0.0)) throw std::invalid_argument("gap_threshold must be positive");
+}
+
+GateVerdict SampleGate::check(Sample& s) {
+  const bool finite = std::isfinite(s.time) && s.orientation.coeffs().allFinite() &&
+                      (!s.has_position() || s.position.allFinite());
+  if (!finite) {
+    ++counters_.rejected_non_finite;
+    return GateVerdict::RejectNonFinite;
+  }
+  const double norm = s.orientation.norm();
+  if (norm == 0.0) {
+    ++counters_.rejected_zero;
+    return GateVerdict::RejectZero;
+  }
+  if (std::abs(norm - 1.0) > config_.unit_tolerance) {
+    ++counters_.rejected_non_unit;
+    return GateVerdict::RejectNonUnit;
+  }
+  if (s.time == last_time_) {
+    ++counters_.dropped_repeated;
+    return GateVerdict::DropRepeated;
+  }
+  if (s.time < last_time_) {
+    ++counters_.dropped_out_of_order;
+    return GateVerdict::DropOutOfOrder;
+  }
+  if (norm != 1.0) {
+    s.orientation.coeffs() /= norm;
+    ++counters_.renormalised;
+  }
+  const bool gap = s.time - last_time_ > config_.gap_threshold && std::isfinite(last_time_);
+  last_time_ = s.time;
+  ++counters_.accepted;
+  if (gap) {
+    ++counters_.gaps;
+    return GateVerdict::AcceptAfterGap;
+  }
+  return GateVerdict::Accept;
+}
+
+}  // namespace posefair
