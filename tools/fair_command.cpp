@@ -1,6 +1,9 @@
 #include "fair_command.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <vector>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -14,6 +17,7 @@
 #include <stdexcept>
 
 #include "exit_codes.hpp"
+#include "posefair/core/causal_fairing.hpp"
 #include "posefair/core/fairing.hpp"
 #include "posefair/drivers/pose_file.hpp"
 
@@ -29,7 +33,77 @@ struct FairOptions {
   bool quiet = false;
   FairingParams params;
   double eps_r_rotation = std::numeric_limits<double>::infinity();  // physical angle, rad
+  // --causal: the real-time engine over the file.
+  bool causal = false;
+  WindowConfig window;
+  std::optional<double> cutoff_hz;      // sets window.smoothing_r/t from the file's rate
+  std::optional<double> smoothing;      // μ for both rotation and position
+  std::optional<int> window_iterations;
 };
+
+// The median sample interval's rate: robust to gaps and a few repeated timestamps.
+double median_rate_hz(const PoseSequence& s) {
+  std::vector<double> dt;
+  for (std::size_t i = 1; i < s.size(); ++i)
+    if (s.time[i] > s.time[i - 1]) dt.push_back(s.time[i] - s.time[i - 1]);
+  if (dt.empty()) return 0.0;
+  std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+  return 1.0 / dt[dt.size() / 2];
+}
+
+int run_causal(const FairOptions& o, const drivers::PoseFile& file) {
+  const PoseSequence& in = file.poses();
+  WindowConfig c = o.window;
+  c.epsilon_r = o.eps_r_rotation / 2.0;
+  c.epsilon_t = o.params.epsilon_t;
+  c.order = o.params.order;
+  c.lambda_r = o.params.lambda_r;
+  c.lambda_t = o.params.lambda_t;
+  c.variant = o.params.variant;
+  if (o.window_iterations) c.iterations = *o.window_iterations;
+  const double rate = median_rate_hz(in);
+  if (o.smoothing) c.smoothing_r = c.smoothing_t = *o.smoothing;
+  if (o.cutoff_hz) {
+    try {
+      c.smoothing_r = c.smoothing_t = smoothing_for_cutoff(*o.cutoff_hz, rate, c.order);
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "posefair fair: --cutoff " << *o.cutoff_hz << " Hz at the file's " << rate << " Hz: " << e.what() << "\n";
+      return kExitUsage;
+    }
+  }
+  try {
+    validate(c);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "posefair fair: " << e.what() << "\n";
+    return kExitUsage;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const CausalResult r = fair_causal(in, c);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  try {
+    drivers::write_pose_file(o.output, file, r.poses);
+  } catch (const drivers::PoseFileError& e) {
+    std::cerr << "posefair fair: " << e.what() << "\n";
+    return kExitCantCreate;
+  }
+  if (!o.quiet) {
+    const char* solver = c.solver == WindowSolver::Linear ? "linear" : c.solver == WindowSolver::GaussNewton ? "gauss-newton" : "sweeps";
+    std::printf("input    %s: %zu samples, %s, %s, %.1f Hz median rate\n", o.input.c_str(), in.size(),
+                std::string(drivers::to_string(file.format())).c_str(),
+                in.has_position() ? "orientation + position" : "orientation only", rate);
+    std::printf("causal   m=%d, %s solver, window %d, lag %d (%.3g ms), iterations %d, mu_r %.6g, continuity %g, bound per %s\n",
+                c.order, solver, c.window, c.lag, rate > 0 ? 1000.0 * c.lag / rate : 0.0, c.iterations, c.smoothing_r,
+                c.continuity, c.bound == BoundPolicy::Sample ? "sample" : "window");
+    std::printf("samples  %llu emitted, %llu clamped to the bound, %llu restarts after gaps, %llu dropped, %llu rejected\n",
+                static_cast<unsigned long long>(r.counters.emitted), static_cast<unsigned long long>(r.counters.clamped),
+                static_cast<unsigned long long>(r.counters.restarts), static_cast<unsigned long long>(r.gate.dropped()),
+                static_cast<unsigned long long>(r.gate.rejected()));
+    std::printf("max dev  rotation %.6g rad (%.4g deg)", 2.0 * r.max_dist_r, 2.0 * r.max_dist_r * 180.0 / std::numbers::pi);
+    if (in.has_position()) std::printf(", position %.6g", r.max_deviation_t);
+    std::printf("\ncost     %.0f ns per sample\nwrote    %s\n", 1e9 * seconds / std::max<std::size_t>(1, in.size()), o.output.c_str());
+  }
+  return kExitOk;
+}
 
 double mean_rate_hz(const PoseSequence& s) {
   if (s.size() < 2 || s.time.back() <= s.time.front()) return 0.0;
@@ -60,6 +134,7 @@ int run_fair(FairOptions o) {
   }
   const drivers::PoseFile& file = *read;
   for (const std::string& w : file.warnings()) std::cerr << "posefair fair: warning: " << w << "\n";
+  if (o.causal) return run_causal(o, file);
   const PoseSequence& in = file.poses();
   try {
     const FairingResult r = fair(in, o.params);
@@ -136,6 +211,38 @@ void add_fair_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--variant", o->params.variant, "rotation operators: corrected (default) or printed (the paper's as printed)")
       ->transform(CLI::CheckedTransformer(variants, CLI::ignore_case));
   cmd->add_flag("-q,--quiet", o->quiet, "print nothing on success");
+
+  // The real-time engine, run over the file exactly as the daemon runs it (docs/engine.md).
+  auto* causal = cmd->add_flag("--causal", o->causal, "run the real-time sliding-window engine instead of batch fairing");
+  cmd->add_option("--window", o->window.window, "causal: window length W (samples)")->capture_default_str()->needs(causal);
+  cmd->add_option("--lag", o->window.lag, "causal: output lag L (samples; 0 = no added delay)")->capture_default_str()->needs(causal);
+  const std::map<std::string, WindowSolver> solvers{{"linear", WindowSolver::Linear},
+                                                    {"gauss-newton", WindowSolver::GaussNewton},
+                                                    {"sweeps", WindowSolver::DampedSweeps}};
+  cmd->add_option("--solver", o->window.solver, "causal: linear (default), gauss-newton, or sweeps (the paper's operators)")
+      ->transform(CLI::CheckedTransformer(solvers, CLI::ignore_case))
+      ->needs(causal);
+  cmd->add_option("--window-iterations", o->window_iterations, "causal: Gauss-Newton iterations or damped sweeps per sample (default 1)")
+      ->check(CLI::Range(0, 1000))
+      ->needs(causal);
+  auto* smoothing = cmd->add_option("--smoothing", o->smoothing, "causal: smoothing weight mu of E_m against the data term")
+                        ->check(CLI::NonNegativeNumber)
+                        ->needs(causal);
+  cmd->add_option("--cutoff", o->cutoff_hz, "causal: set mu for this half-power frequency (Hz) at the file's rate")
+      ->check(CLI::PositiveNumber)
+      ->excludes(smoothing)
+      ->needs(causal);
+  cmd->add_option("--continuity", o->window.continuity, "causal: weight kappa pulling the window toward poses already emitted")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(causal);
+  const std::map<std::string, BoundPolicy> bounds{{"sample", BoundPolicy::Sample}, {"window", BoundPolicy::Window}};
+  cmd->add_option("--bound", o->window.bound, "causal: enforce eps per emitted sample (default) or on the whole window")
+      ->transform(CLI::CheckedTransformer(bounds, CLI::ignore_case))
+      ->needs(causal);
+  cmd->add_option("--gap", o->window.gate.gap_threshold, "causal: a time step longer than this (s) restarts the window")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->needs(causal);
   cmd->callback([o, &exit_code] { exit_code = run_fair(*o); });
 }
 

@@ -100,6 +100,68 @@ FairingWindow::FairingWindow(const WindowConfig& config) : config_(config), gate
       factors_r_[static_cast<std::size_t>(n)] = make_smoothing_system(n, config.order, config.smoothing_r, std::span(diag_).first(static_cast<std::size_t>(n)));
       factors_t_[static_cast<std::size_t>(n)] = make_smoothing_system(n, config.order, config.smoothing_t, std::span(diag_).first(static_cast<std::size_t>(n)));
     }
+    if (config.solver == WindowSolver::Linear) precompute_linear_rows();
+  }
+}
+
+void FairingWindow::precompute_linear_rows() {
+  // Row k of A⁻¹ is r = A⁻¹ e_k (A is symmetric). The emitted estimate is
+  //   e_k = rᵀ(κ E c − μ (D^m)ᵀ D^{m−1} ζ) = Σ κ r_i c_i (emitted i) + hᵀζ,  h = −μ (D^{m−1})ᵀ D^m r,
+  //   p_k = rᵀ(z_p + κ E y_p).
+  const int w = config_.window, m = config_.order, lag = config_.lag;
+  row_zeta_.resize(static_cast<std::size_t>(w + 1));
+  row_c_.resize(static_cast<std::size_t>(w + 1));
+  row_p_.resize(static_cast<std::size_t>(w + 1));
+  std::vector<Vec3> unit(static_cast<std::size_t>(w));
+  for (int n = 1; n <= w; ++n) {
+    const int k = n - 1 - lag;
+    if (k < 0) continue;
+    for (const bool rotation : {true, false}) {
+      std::fill(unit.begin(), unit.end(), Vec3::Zero());
+      unit[static_cast<std::size_t>(k)] = Vec3::Ones();
+      (rotation ? factors_r_ : factors_t_)[static_cast<std::size_t>(n)].solve(std::span(unit).first(static_cast<std::size_t>(n)));
+      std::vector<double> r(static_cast<std::size_t>(n));
+      for (int i = 0; i < n; ++i) r[static_cast<std::size_t>(i)] = unit[static_cast<std::size_t>(i)].x();
+      auto& c = rotation ? row_c_[static_cast<std::size_t>(n)] : row_p_[static_cast<std::size_t>(n)];
+      c.assign(static_cast<std::size_t>(n), 0.0);
+      for (int i = 0; i < n; ++i) {
+        const bool emitted = i < n - 1 - lag;
+        c[static_cast<std::size_t>(i)] = rotation ? (emitted ? config_.continuity * r[static_cast<std::size_t>(i)] : 0.0)
+                                                  : r[static_cast<std::size_t>(i)];
+      }
+      if (!rotation) continue;
+      auto& h = row_zeta_[static_cast<std::size_t>(n)];
+      h.assign(static_cast<std::size_t>(std::max(0, n - 1)), 0.0);
+      if (n <= m || config_.smoothing_r == 0.0) continue;
+      // h = −μ (D^{m−1})ᵀ D^m r, with the same difference/adjoint passes the solver uses.
+      for (int i = 0; i < n; ++i) unit[static_cast<std::size_t>(i)] = Vec3::Constant(r[static_cast<std::size_t>(i)]);
+      int len = n;
+      for (int p = 0; p < m; ++p) difference(unit, len--);
+      for (int p = 1; p < m; ++p) difference_adjoint(unit, len++);
+      for (int j = 0; j < n - 1; ++j) h[static_cast<std::size_t>(j)] = -config_.smoothing_r * unit[static_cast<std::size_t>(j)].x();
+    }
+  }
+}
+
+void FairingWindow::linear_emission_estimate(int k) {
+  const auto n = static_cast<std::size_t>(n_);
+  const auto& h = row_zeta_[n];
+  const auto& g = row_c_[n];
+  Vec3 e = Vec3::Zero();
+  for (std::size_t j = 0; j + 1 < n; ++j) e += h[j] * zeta_[j];
+  if (config_.continuity > 0.0)
+    for (std::size_t i = 0; i < n; ++i) e += g[i] * c_[i];
+  est_[static_cast<std::size_t>(k)] = e;
+  if (positions_) {
+    const auto& rp = row_p_[n];
+    Vec3 p = Vec3::Zero();
+    const int emitted = n_ - 1 - config_.lag;
+    for (std::size_t i = 0; i < n; ++i) {
+      Vec3 v = zp_[i];
+      if (config_.continuity > 0.0 && static_cast<int>(i) < emitted) v += config_.continuity * yp_[i];
+      p += rp[i] * v;
+    }
+    xp_[static_cast<std::size_t>(k)] = p;
   }
 }
 
@@ -159,6 +221,8 @@ FairedPose FairingWindow::emit(int index) {
 
 int FairingWindow::emit_pending(std::span<FairedPose> out) {
   int count = 0;
+  // The linear solver keeps no estimates between samples: solve the whole window once here.
+  if (config_.solver == WindowSolver::Linear && first_unemitted() < n_) solve();
   for (int i = first_unemitted(); i < n_; ++i) out[static_cast<std::size_t>(count++)] = emit(i);
   n_ = 0;
   return count;
@@ -177,8 +241,13 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
     ++counters_.restarts;
   }
   append(s);
-  solve();
   const int k = n_ - 1 - config_.lag;
+  if (config_.solver == WindowSolver::Linear) {
+    // Only the emitted sample's estimate is needed: one precomputed dot product.
+    if (k >= 0) linear_emission_estimate(k);
+  } else {
+    solve();
+  }
   if (k >= 0) out[static_cast<std::size_t>(count++)] = emit(k);
   return count;
 }

@@ -92,6 +92,8 @@ class FairingWindow {
   void append(const Sample& s);
   void solve();
   void linear_rotation(const BandedCholesky& a);
+  void linear_emission_estimate(int k);
+  void precompute_linear_rows();
   void gauss_newton_rotation(const BandedCholesky& a);
   void smoothness_gradient(std::span<const Vec3> w1);
   void solve_positions(const BandedCholesky& a);
@@ -122,6 +124,10 @@ class FairingWindow {
   std::vector<double> diag_;
   // factors_r_[n], factors_t_[n]: the system for a window holding n samples.
   std::vector<BandedCholesky> factors_r_, factors_t_;
+  // Linear: the emitted sample's estimate is a fixed linear function of the window, so its
+  // coefficients are precomputed per fill level n (row_zeta_[n]: n-1 weights on ζ, row_c_[n]:
+  // n weights on c, row_p_[n]: n weights on z_p + κ y_p). One dot product per sample.
+  std::vector<std::vector<double>> row_zeta_, row_c_, row_p_;
 };
 
 }  // namespace posefair
