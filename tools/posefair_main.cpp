@@ -1,6 +1,7 @@
 // posefair: the command-line tool. Each subcommand lives in its own <name>_command.cpp.
 #include <CLI/CLI.hpp>
 
+#include "bench_quality_command.hpp"
 #include "exit_codes.hpp"
 #include "fair_command.hpp"
 #include "reproduce_command.hpp"
@@ -12,6 +13,7 @@ int main(int argc, char** argv) {
   int exit_code = posefair::tools::kExitOk;
   posefair::tools::add_fair_command(app, exit_code);
   posefair::tools::add_reproduce_command(app, exit_code);
+  posefair::tools::add_bench_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

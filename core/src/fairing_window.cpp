@@ -1,6 +1,8 @@
 #include "posefair/core/fairing_window.hpp"
 
 #include <algorithm>
+
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -54,13 +56,16 @@ void validate(const WindowConfig& c) {
   if (c.lag < 0 || c.lag >= c.window)
     bad("lag must be in [0, window-1] = [0, " + std::to_string(c.window - 1) + "], got " + std::to_string(c.lag));
   if (c.iterations < 0 || c.iterations > 1000) bad("iterations must be in [0, 1000], got " + std::to_string(c.iterations));
-  if (!(c.smoothing_r >= 0.0) || !std::isfinite(c.smoothing_r)) bad("smoothing_r must be finite and >= 0");
-  if (!(c.smoothing_t >= 0.0) || !std::isfinite(c.smoothing_t)) bad("smoothing_t must be finite and >= 0");
+  // Beyond about 1e10 the window is already an exact polynomial fit and the system only loses
+  // precision (I + μDᵀD becomes numerically singular).
+  if (!(c.smoothing_r >= 0.0 && c.smoothing_r <= kMaxSmoothing)) bad("smoothing_r must be in [0, 1e10], got " + std::to_string(c.smoothing_r));
+  if (!(c.smoothing_t >= 0.0 && c.smoothing_t <= kMaxSmoothing)) bad("smoothing_t must be in [0, 1e10], got " + std::to_string(c.smoothing_t));
   if (!(c.continuity >= 0.0) || !std::isfinite(c.continuity)) bad("continuity must be finite and >= 0");
   if (!(c.lambda_r > 0.0 && c.lambda_r <= 1.0)) bad("lambda_r must be in (0, 1]");
   if (!(c.lambda_t > 0.0 && c.lambda_t <= 1.0)) bad("lambda_t must be in (0, 1]");
   if (!(c.epsilon_r > 0.0)) bad("epsilon_r must be positive");
   if (!(c.epsilon_t > 0.0)) bad("epsilon_t must be positive");
+  if (c.continuity > 0.0 && c.window > 512) bad("continuity needs a window of at most 512 samples");
   if (c.bound == BoundPolicy::Window && c.solver == WindowSolver::Linear)
     bad("the window bound policy needs an iterative solver (gauss-newton or sweeps); linear solves in closed form");
 }
@@ -100,8 +105,31 @@ FairingWindow::FairingWindow(const WindowConfig& config) : config_(config), gate
       factors_r_[static_cast<std::size_t>(n)] = make_smoothing_system(n, config.order, config.smoothing_r, std::span(diag_).first(static_cast<std::size_t>(n)));
       factors_t_[static_cast<std::size_t>(n)] = make_smoothing_system(n, config.order, config.smoothing_t, std::span(diag_).first(static_cast<std::size_t>(n)));
     }
-    if (config.solver == WindowSolver::Linear) precompute_linear_rows();
+    if (config.solver == WindowSolver::Linear || config.continuity > 0.0) precompute_linear_rows();
+    if (config.continuity > 0.0) check_continuity_stability();
   }
+}
+
+// With κ > 0 every emitted orientation feeds back into later ones: in a full window the
+// emitted correction obeys c_k = Σ_j a_j c_{k−j} + (terms in the data), a linear recursion that
+// diverges for some (μ, κ, W, L). Its characteristic roots are the eigenvalues of the companion
+// matrix of a; a configuration whose spectral radius is not below 1 is refused here rather than
+// left to blow up on a live stream.
+void FairingWindow::check_continuity_stability() const {
+  const int w = config_.window, lag = config_.lag;
+  const int taps = w - 1 - lag;  // emitted samples in a full window
+  if (taps <= 0) return;
+  const auto& g = row_c_[static_cast<std::size_t>(w)];
+  Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(taps, taps);
+  // c at window index taps-1 is the newest emitted (one step back), index 0 the oldest.
+  for (int j = 1; j <= taps; ++j) companion(0, j - 1) = g[static_cast<std::size_t>(taps - j)];
+  for (int j = 1; j < taps; ++j) companion(j, j - 1) = 1.0;
+  const double radius = companion.eigenvalues().cwiseAbs().maxCoeff();
+  if (!(radius < 1.0 - 1e-9))
+    throw std::invalid_argument("continuity " + std::to_string(config_.continuity) + " with smoothing " +
+                                std::to_string(config_.smoothing_r) + ", window " + std::to_string(w) + " and lag " +
+                                std::to_string(lag) + " makes the output recursion unstable (spectral radius " +
+                                std::to_string(radius) + "); lower the continuity or the smoothing");
 }
 
 void FairingWindow::precompute_linear_rows() {
@@ -149,8 +177,9 @@ void FairingWindow::linear_emission_estimate(int k) {
   const auto& g = row_c_[n];
   Vec3 e = Vec3::Zero();
   for (std::size_t j = 0; j + 1 < n; ++j) e += h[j] * zeta_[j];
+  // Only emitted samples carry a c (the others' entries are stale or unset, and g is 0 there).
   if (config_.continuity > 0.0)
-    for (std::size_t i = 0; i < n; ++i) e += g[i] * c_[i];
+    for (std::size_t i = 0; static_cast<int>(i) < n_ - 1 - config_.lag; ++i) e += g[i] * c_[i];
   est_[static_cast<std::size_t>(k)] = e;
   if (positions_) {
     const auto& rp = row_p_[n];

@@ -54,7 +54,11 @@ struct WindowConfig {
   GateConfig gate;
 };
 
-// Throws std::invalid_argument naming the field and its valid range.
+// Largest accepted smoothing weight μ (see validate()).
+inline constexpr double kMaxSmoothing = 1e10;
+
+// Throws std::invalid_argument naming the field and its valid range. The constructor also
+// refuses a continuity κ > 0 that would make the output recursion unstable.
 void validate(const WindowConfig& config);
 
 // μ for which the steady-state Whittaker smoother I + μ(D^m)ᵀD^m halves the power at
@@ -94,6 +98,7 @@ class FairingWindow {
   void linear_rotation(const BandedCholesky& a);
   void linear_emission_estimate(int k);
   void precompute_linear_rows();
+  void check_continuity_stability() const;
   void gauss_newton_rotation(const BandedCholesky& a);
   void smoothness_gradient(std::span<const Vec3> w1);
   void solve_positions(const BandedCholesky& a);

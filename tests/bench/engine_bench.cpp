@@ -1,0 +1,112 @@
+// Real-time engine cost per sample (orientation only unless named), against One Euro in the
+// same run. docs/engine.md reports these numbers. Run: build/tests/bench/engine_bench
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+
+#include "posefair/core/fairing_window.hpp"
+#include "posefair/core/one_euro_filter.hpp"
+#include "posefair/core/synthetic_motion.hpp"
+
+namespace posefair {
+namespace {
+
+const SyntheticMotion& stream(bool with_position) {
+  static const SyntheticMotion plain = [] {
+    SyntheticMotionSpec s;
+    s.samples = 20000;
+    s.sample_rate_hz = 1000.0;
+    s.cycles = 10.0;
+    s.with_position = false;
+    return make_synthetic_motion(s);
+  }();
+  static const SyntheticMotion posed = [] {
+    SyntheticMotionSpec s;
+    s.samples = 20000;
+    s.sample_rate_hz = 1000.0;
+    s.cycles = 10.0;
+    return make_synthetic_motion(s);
+  }();
+  return with_position ? posed : plain;
+}
+
+void run_window(benchmark::State& state, WindowConfig c, bool with_position) {
+  const auto& m = stream(with_position);
+  FairingWindow w(c);
+  std::vector<FairedPose> out(static_cast<std::size_t>(w.max_outputs_per_push()));
+  std::size_t i = 0;
+  double t = 0.0;
+  for (auto _ : state) {
+    Sample s;
+    s.time = t;
+    t += 0.001;
+    s.orientation = m.noisy.orientation[i];
+    if (with_position) {
+      s.position = m.noisy.position[i];
+      s.flags = kHasPosition;
+    }
+    benchmark::DoNotOptimize(w.push(s, out));
+    benchmark::DoNotOptimize(out[0].orientation);
+    if (++i == m.noisy.size()) i = 0;
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["bytes_per_stream"] = static_cast<double>(w.memory_bytes());
+}
+
+// Linear solver: window W, order m, lag, continuity.
+void BM_Linear(benchmark::State& state) {
+  WindowConfig c;
+  c.window = static_cast<int>(state.range(0));
+  c.order = static_cast<int>(state.range(1));
+  c.continuity = static_cast<double>(state.range(2));
+  c.smoothing_r = smoothing_for_cutoff(4.0, 1000.0, c.order);
+  run_window(state, c, state.range(3) != 0);
+}
+BENCHMARK(BM_Linear)
+    ->ArgNames({"W", "m", "kappa", "pos"})
+    ->Args({32, 2, 0, 0})  // the default
+    ->Args({16, 2, 0, 0})
+    ->Args({64, 2, 0, 0})
+    ->Args({128, 2, 0, 0})
+    ->Args({32, 3, 0, 0})
+    ->Args({32, 2, 1, 0})
+    ->Args({32, 2, 0, 1});
+
+// Iterative solvers: W and K (iterations or sweeps).
+void BM_GaussNewton(benchmark::State& state) {
+  WindowConfig c;
+  c.window = static_cast<int>(state.range(0));
+  c.iterations = static_cast<int>(state.range(1));
+  c.solver = WindowSolver::GaussNewton;
+  c.smoothing_r = smoothing_for_cutoff(4.0, 1000.0, 2);
+  run_window(state, c, false);
+}
+BENCHMARK(BM_GaussNewton)->ArgNames({"W", "K"})->Args({16, 1})->Args({32, 1})->Args({32, 2});
+
+void BM_PaperSweeps(benchmark::State& state) {
+  WindowConfig c;
+  c.window = static_cast<int>(state.range(0));
+  c.iterations = static_cast<int>(state.range(1));
+  c.solver = WindowSolver::DampedSweeps;
+  run_window(state, c, false);
+}
+BENCHMARK(BM_PaperSweeps)->ArgNames({"W", "K"})->Args({16, 4})->Args({32, 4})->Args({32, 16});
+
+void BM_OneEuro(benchmark::State& state) {
+  const auto& m = stream(false);
+  QuatOneEuroFilter f(8.0, 0.1, 1.0);
+  std::size_t i = 0;
+  double t = 0.0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(f.filter(m.noisy.orientation[i], t));
+    t += 0.001;
+    if (++i == m.noisy.size()) i = 0;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_OneEuro);
+
+}  // namespace
+}  // namespace posefair
+
+BENCHMARK_MAIN();

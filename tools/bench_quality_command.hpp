@@ -1,0 +1,8 @@
+#pragma once
+#include <CLI/CLI.hpp>
+
+namespace posefair::tools {
+// `posefair bench quality`: posefair's engine against One Euro and the other reference
+// filters on synthetic and recorded data (docs/benchmarks.md).
+void add_bench_command(CLI::App& app, int& exit_code);
+}
