@@ -316,9 +316,10 @@ void FairingWindow::append(const Sample& s) {
     ++n_;
     return;
   }
-  // Warm start: the previous window's estimates stay; the new sample starts from the
-  // constant-velocity prediction of the estimates before it (its measurement if too few).
-  if (n_ >= 2) {
+  // Warm start: the previous window's estimates stay. The paper's sweeps have no data term, so
+  // the new sample must start at its measurement; Gauss–Newton starts it at the
+  // constant-velocity prediction of the estimates before it (its data term pulls it from there).
+  if (n_ >= 2 && config_.solver == WindowSolver::GaussNewton) {
     const Quat& a = x_[k - 2];
     const Quat& b = x_[k - 1];
     x_[k] = so3::aligned_to((b * (a.conjugate() * b)).normalized(), z);
@@ -327,7 +328,7 @@ void FairingWindow::append(const Sample& s) {
   }
   if (positions_) {
     zp_[k] = s.position;
-    xp_[k] = n_ >= 2 ? Vec3(2.0 * xp_[k - 1] - xp_[k - 2]) : s.position;
+    xp_[k] = n_ >= 2 && config_.solver == WindowSolver::GaussNewton ? Vec3(2.0 * xp_[k - 1] - xp_[k - 2]) : s.position;
   }
   ++n_;
 }
