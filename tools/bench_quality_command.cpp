@@ -131,7 +131,8 @@ std::vector<Candidate> candidates(const QualityDataset& d, bool quick) {
         c.epsilon_r = eps;
         c.bound = std::isfinite(eps) ? BoundPolicy::Window : BoundPolicy::Sample;
         c.gate.gap_threshold = 2.5 / rate;
-        std::snprintf(buf, sizeof buf, "m=%d W=%d K=4 lambda_r=%g eps_r=%g bound=window lag=0", m, w, lr, eps);
+        std::snprintf(buf, sizeof buf, "m=%d W=%d K=4 lambda_r=%g eps_r=%g bound=%s lag=0", m, w, lr, eps,
+                      std::isfinite(eps) ? "window" : "none");
         out.push_back({"posefair-sweeps", buf, [c](const PoseSequence& in) { return run_window(in, c); }});
       }
   // One Euro, tuned by grid search per data set.

@@ -1,0 +1,164 @@
+// The ε promise of FairingWindow: every emitted pose lies within ε_r (dist on S³) and ε_t of
+// the measurement it was emitted for, for every solver and bound policy.
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "engine_test_support.hpp"
+#include "posefair/core/fairing_window.hpp"
+
+namespace posefair {
+namespace {
+
+using testing::bound_name;
+using testing::noisy_motion;
+using testing::run;
+using testing::samples_from;
+using testing::solver_name;
+
+struct SolverBound {
+  WindowSolver solver;
+  BoundPolicy bound;
+};
+
+// Every valid pairing (the window policy needs an iterative solver).
+const SolverBound kPairings[] = {
+    {WindowSolver::Linear, BoundPolicy::Sample},
+    {WindowSolver::GaussNewton, BoundPolicy::Sample},
+    {WindowSolver::GaussNewton, BoundPolicy::Window},
+    {WindowSolver::DampedSweeps, BoundPolicy::Sample},
+    {WindowSolver::DampedSweeps, BoundPolicy::Window},
+};
+
+// Index of the first pose outside the bound, or -1.
+int first_violation(const std::vector<FairedPose>& out, double eps_r, double eps_t, std::string* what) {
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const double dr = so3::dist(out[i].orientation, out[i].measured);
+    const double dt = (out[i].position - out[i].measured_position).norm();
+    if (!(dr <= eps_r) || !(dt <= eps_t)) {
+      *what = "pose " + std::to_string(i) + " (sequence " + std::to_string(out[i].sequence) + "): dist " +
+              std::to_string(dr) + " vs eps_r " + std::to_string(eps_r) + ", offset " + std::to_string(dt) +
+              " vs eps_t " + std::to_string(eps_t);
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+TEST(FairingWindowBound, EveryEmittedPoseStaysWithinEpsilonOfItsMeasurement) {
+  // Noise 0.05 (dist) and 10 mm against bounds of 0.01/0.03 and 2/8 mm: the smoother wants to
+  // move many samples further than allowed, so the projection has real work to do.
+  struct Eps {
+    double r, t;
+    bool tight;
+  };
+  const Eps bounds[] = {{0.01, 2.0, true}, {0.03, 8.0, false}};
+  int case_index = 0;
+  for (const SolverBound& sb : kPairings) {
+    for (int order : {2, 3}) {
+      for (int lag : {0, 3}) {
+        for (bool with_position : {false, true}) {
+          for (const Eps& eps : bounds) {
+            ++case_index;
+            const auto motion = noisy_motion(static_cast<std::uint64_t>(case_index), with_position, 300, 0.05, 10.0);
+            std::vector<Sample> in = samples_from(motion.noisy);
+            // A gap in the middle: the samples pending at the restart are emitted by the
+            // restart path and must respect the bound too.
+            for (std::size_t i = 150; i < in.size(); ++i) in[i].time += 1.0;
+            WindowConfig c;
+            c.solver = sb.solver;
+            c.bound = sb.bound;
+            c.order = order;
+            c.lag = lag;
+            c.window = 24;
+            c.iterations = 3;
+            c.smoothing_r = smoothing_for_cutoff(2.0, 100.0, order);
+            c.smoothing_t = c.smoothing_r;
+            c.continuity = case_index % 2 == 0 ? 1.0 : 0.0;
+            c.epsilon_r = eps.r;
+            c.epsilon_t = eps.t;
+            SCOPED_TRACE(std::string(solver_name(sb.solver)) + " bound=" + bound_name(sb.bound) + " order=" +
+                         std::to_string(order) + " lag=" + std::to_string(lag) +
+                         (with_position ? " with positions" : " orientation only") + " eps_r=" + std::to_string(eps.r) +
+                         " kappa=" + std::to_string(c.continuity));
+            FairingWindow w(c);
+            const auto out = run(w, in);
+            ASSERT_EQ(out.size(), in.size());
+            std::string what;
+            EXPECT_EQ(first_violation(out, eps.r, eps.t, &what), -1) << what;
+            EXPECT_EQ(w.counters().restarts, 1u);
+            EXPECT_EQ(w.counters().emitted, in.size());
+            EXPECT_LE(w.counters().clamped, w.counters().emitted);
+            if (eps.tight) {
+              // The bound must actually have been exercised.
+              EXPECT_GT(w.counters().clamped, 0u);
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST(FairingWindowBound, ClampedOutputsLieOnTheBoundaryNotInsideIt) {
+  // With ε far below the noise, a clamped pose is the point of the ε-ball nearest the
+  // estimate: it sits on the sphere of radius ε (minus the documented 1e-9 relative margin).
+  const auto motion = noisy_motion(41, true, 300, 0.05, 10.0);
+  const auto in = samples_from(motion.noisy);
+  for (WindowSolver solver : {WindowSolver::Linear, WindowSolver::GaussNewton}) {
+    SCOPED_TRACE(solver_name(solver));
+    WindowConfig c = testing::smoothing_config(solver, 2, 0);
+    c.epsilon_r = 0.002;
+    c.epsilon_t = 0.5;
+    FairingWindow w(c);
+    const auto out = run(w, in);
+    std::size_t on_boundary = 0;
+    for (const FairedPose& p : out) {
+      const double dr = so3::dist(p.orientation, p.measured);
+      ASSERT_LE(dr, c.epsilon_r);
+      if (dr > c.epsilon_r * (1.0 - 1e-6)) ++on_boundary;
+    }
+    // Uniform noise magnitude up to 0.05 against ε = 0.002: nearly every sample gets clamped.
+    EXPECT_GT(w.counters().clamped, out.size() * 9 / 10);
+    EXPECT_GT(on_boundary, out.size() * 9 / 10);
+  }
+}
+
+TEST(FairingWindowBound, UnboundedOrLooseEpsilonNeverCountsAClamp) {
+  const auto motion = noisy_motion(42, true, 300, 0.02, 5.0);
+  const auto in = samples_from(motion.noisy);
+  for (WindowSolver solver : {WindowSolver::Linear, WindowSolver::GaussNewton}) {
+    SCOPED_TRACE(solver_name(solver));
+    for (double eps_r : {std::numeric_limits<double>::infinity(), 0.5}) {
+      WindowConfig c = testing::smoothing_config(solver, 3, 3);
+      c.epsilon_r = eps_r;
+      c.epsilon_t = std::isinf(eps_r) ? eps_r : 100.0;
+      FairingWindow w(c);
+      const auto out = run(w, in);
+      EXPECT_EQ(w.counters().clamped, 0u);
+      EXPECT_EQ(out.size(), in.size());
+    }
+  }
+}
+
+TEST(FairingWindowBound, ATinyEpsilonReproducesTheMeasurement) {
+  // ε_r = 1e-6 rad, ε_t = 1e-4 mm: the output is the input for every practical purpose.
+  const auto motion = noisy_motion(43, true, 200, 0.05, 10.0);
+  const auto in = samples_from(motion.noisy);
+  for (const SolverBound& sb : kPairings) {
+    SCOPED_TRACE(std::string(solver_name(sb.solver)) + " bound=" + bound_name(sb.bound));
+    WindowConfig c = testing::smoothing_config(sb.solver, 2, 2);
+    c.bound = sb.bound;
+    c.epsilon_r = 1e-6;
+    c.epsilon_t = 1e-4;
+    const auto out = run(c, in);
+    std::string what;
+    EXPECT_EQ(first_violation(out, c.epsilon_r, c.epsilon_t, &what), -1) << what;
+  }
+}
+
+}  // namespace
+}  // namespace posefair

@@ -1,0 +1,263 @@
+// FairingWindow's promise that push() and flush() never allocate. This binary replaces the
+// global operator new/delete with counting versions, so it must not share an executable with
+// other tests.
+#include <atomic>
+#include <cstddef>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "posefair/core/fairing_window.hpp"
+#include "posefair/core/synthetic_motion.hpp"
+
+namespace {
+
+std::atomic<std::size_t> g_allocations{0};
+std::atomic<std::ptrdiff_t> g_live_bytes{0};  // requested bytes not yet freed
+void* volatile g_sink = nullptr;  // pointers escape here so test allocations cannot be elided
+
+// Each block carries its requested size in a header in front of it (kHeader bytes, or the
+// alignment for over-aligned blocks) so that the unsized deletes can account for it too.
+constexpr std::size_t kHeader = alignof(std::max_align_t);
+
+void* counted_alloc(std::size_t size, std::size_t align) {
+  const std::size_t header = align > kHeader ? align : kHeader;
+  const std::size_t total = (size + header + header - 1) / header * header;  // aligned_alloc wants a multiple
+  auto* base = static_cast<unsigned char*>(align > kHeader ? std::aligned_alloc(align, total) : std::malloc(total));
+  if (base == nullptr) return nullptr;
+  std::memcpy(base, &size, sizeof size);
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  g_live_bytes.fetch_add(static_cast<std::ptrdiff_t>(size), std::memory_order_relaxed);
+  return base + header;
+}
+
+// Out of line, so that GCC does not see free() applied to what operator new returned once the
+// replacement deletes are inlined (-Wmismatched-new-delete cannot tell they belong together).
+[[gnu::noinline]] void counted_free(void* p, std::size_t align) noexcept {
+  if (p == nullptr) return;
+  const std::size_t header = align > kHeader ? align : kHeader;
+  unsigned char* base = static_cast<unsigned char*>(p) - header;
+  std::size_t size = 0;
+  std::memcpy(&size, base, sizeof size);
+  g_live_bytes.fetch_sub(static_cast<std::ptrdiff_t>(size), std::memory_order_relaxed);
+  std::free(base);
+}
+
+void* alloc_or_throw(std::size_t size, std::size_t align) {
+  if (void* p = counted_alloc(size, align)) return p;
+  throw std::bad_alloc();
+}
+
+}  // namespace
+
+// Every replaceable allocation function.
+void* operator new(std::size_t size) { return alloc_or_throw(size, 0); }
+void* operator new[](std::size_t size) { return alloc_or_throw(size, 0); }
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return counted_alloc(size, 0); }
+void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return counted_alloc(size, 0); }
+void* operator new(std::size_t size, std::align_val_t al) { return alloc_or_throw(size, static_cast<std::size_t>(al)); }
+void* operator new[](std::size_t size, std::align_val_t al) { return alloc_or_throw(size, static_cast<std::size_t>(al)); }
+void* operator new(std::size_t size, std::align_val_t al, const std::nothrow_t&) noexcept {
+  return counted_alloc(size, static_cast<std::size_t>(al));
+}
+void* operator new[](std::size_t size, std::align_val_t al, const std::nothrow_t&) noexcept {
+  return counted_alloc(size, static_cast<std::size_t>(al));
+}
+void operator delete(void* p) noexcept { counted_free(p, 0); }
+void operator delete[](void* p) noexcept { counted_free(p, 0); }
+void operator delete(void* p, std::size_t) noexcept { counted_free(p, 0); }
+void operator delete[](void* p, std::size_t) noexcept { counted_free(p, 0); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { counted_free(p, 0); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { counted_free(p, 0); }
+void operator delete(void* p, std::align_val_t al) noexcept { counted_free(p, static_cast<std::size_t>(al)); }
+void operator delete[](void* p, std::align_val_t al) noexcept { counted_free(p, static_cast<std::size_t>(al)); }
+void operator delete(void* p, std::size_t, std::align_val_t al) noexcept { counted_free(p, static_cast<std::size_t>(al)); }
+void operator delete[](void* p, std::size_t, std::align_val_t al) noexcept { counted_free(p, static_cast<std::size_t>(al)); }
+void operator delete(void* p, std::align_val_t al, const std::nothrow_t&) noexcept {
+  counted_free(p, static_cast<std::size_t>(al));
+}
+void operator delete[](void* p, std::align_val_t al, const std::nothrow_t&) noexcept {
+  counted_free(p, static_cast<std::size_t>(al));
+}
+
+namespace posefair {
+namespace {
+
+std::size_t allocations() { return g_allocations.load(std::memory_order_relaxed); }
+std::ptrdiff_t live_bytes() { return g_live_bytes.load(std::memory_order_relaxed); }
+
+TEST(WindowAllocation, TheCounterSeesAllocations) {
+  // Without this the zero below would prove nothing.
+  const std::size_t before = allocations();
+  auto* v = new std::vector<double>(100);
+  g_sink = v;
+  auto* aligned = new Eigen::Matrix4d[3];
+  g_sink = aligned;
+  auto* over_aligned = new (std::align_val_t{64}) double[5];
+  g_sink = over_aligned;
+  delete v;
+  delete[] aligned;
+  ::operator delete[](over_aligned, std::align_val_t{64});
+  EXPECT_GE(allocations() - before, 4u);  // the vector, its buffer, the array, the aligned block
+  const std::ptrdiff_t live = live_bytes();
+  auto* block = new double[1000];
+  g_sink = block;
+  EXPECT_EQ(live_bytes() - live, static_cast<std::ptrdiff_t>(1000 * sizeof(double)));
+  delete[] block;
+  EXPECT_EQ(live_bytes(), live);
+}
+
+// A stream of `n` samples with positions, continuing in time from `t0`.
+std::vector<Sample> stream(std::size_t n, double t0, std::uint64_t seed) {
+  SyntheticMotionSpec spec;
+  spec.samples = n;
+  spec.cycles = static_cast<double>(n) / 300.0;
+  spec.rotation_noise = 0.04;
+  spec.position_noise = 8.0;
+  spec.seed = seed;
+  const SyntheticMotion m = make_synthetic_motion(spec);
+  std::vector<Sample> out(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    out[i].sequence = i;
+    out[i].time = t0 + m.noisy.time[i];
+    out[i].orientation = m.noisy.orientation[i];
+    out[i].position = m.noisy.position[i];
+    out[i].flags = kHasPosition;
+  }
+  return out;
+}
+
+struct Case {
+  const char* name;
+  WindowSolver solver;
+  BoundPolicy bound;
+};
+
+TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
+  const Case cases[] = {
+      {"linear", WindowSolver::Linear, BoundPolicy::Sample},
+      {"gauss-newton", WindowSolver::GaussNewton, BoundPolicy::Sample},
+      {"gauss-newton window bound", WindowSolver::GaussNewton, BoundPolicy::Window},
+      {"sweeps", WindowSolver::DampedSweeps, BoundPolicy::Sample},
+      {"sweeps window bound", WindowSolver::DampedSweeps, BoundPolicy::Window},
+  };
+  constexpr std::size_t kWarmUp = 300, kMeasured = 10000;
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    WindowConfig config;
+    config.solver = c.solver;
+    config.bound = c.bound;
+    config.order = 3;
+    config.window = 32;
+    config.lag = 4;
+    config.iterations = 3;
+    config.continuity = 0.5;
+    config.smoothing_r = smoothing_for_cutoff(4.0, 100.0, 3);
+    config.smoothing_t = config.smoothing_r;
+    config.epsilon_r = 0.02;  // tight enough that the projections run
+    config.epsilon_t = 4.0;
+    FairingWindow w(config);
+    const std::size_t bytes = w.memory_bytes();
+    EXPECT_GT(bytes, 0u);
+
+    // Everything the measured loop touches exists before it starts.
+    const std::vector<Sample> warm = stream(kWarmUp, 0.0, 1);
+    std::vector<Sample> measured = stream(kMeasured, warm.back().time + 0.01, 2);
+    for (std::size_t i = 4000; i < measured.size(); ++i) measured[i].time += 1.0;  // a gap: restart
+    Sample bad = measured[5000];
+    bad.orientation.coeffs() *= 2.0;  // rejected by the gate
+    std::vector<FairedPose> out(static_cast<std::size_t>(w.max_outputs_per_push()));
+
+    std::size_t emitted = 0;
+    for (const Sample& s : warm) emitted += static_cast<std::size_t>(w.push(s, out));
+
+    // The measured run: no gtest assertions inside (they may allocate), only plain bookkeeping.
+    bool memory_changed = false;
+    const std::size_t before = allocations();
+    for (std::size_t i = 0; i < measured.size(); ++i) {
+      emitted += static_cast<std::size_t>(w.push(measured[i], out));
+      if (i == 5000) emitted += static_cast<std::size_t>(w.push(bad, out));
+      if (i == 6999) emitted += static_cast<std::size_t>(w.flush(out));
+      if (i % 1000 == 0) memory_changed = memory_changed || w.memory_bytes() != bytes;
+    }
+    emitted += static_cast<std::size_t>(w.flush(out));
+    const std::size_t during = allocations() - before;
+
+    EXPECT_EQ(during, 0u) << "push()/flush() allocated";
+    EXPECT_FALSE(memory_changed);
+    EXPECT_EQ(w.memory_bytes(), bytes);
+    // The run did what it was meant to: everything emitted once, one gap restart, a rejection,
+    // and the bound was exercised.
+    EXPECT_EQ(emitted, kWarmUp + kMeasured);
+    EXPECT_EQ(w.counters().restarts, 1u);
+    EXPECT_EQ(w.gate_counters().rejected_non_unit, 1u);
+    EXPECT_GT(w.counters().clamped, 0u);
+  }
+}
+
+TEST(WindowAllocation, MemoryGrowsWithTheWindowAndIsFixedAtConstruction) {
+  WindowConfig small, large;
+  small.window = 8;
+  large.window = 64;
+  const FairingWindow a(small), b(large);
+  EXPECT_GT(a.memory_bytes(), sizeof(FairingWindow));
+  EXPECT_GT(b.memory_bytes(), a.memory_bytes());
+}
+
+}  // namespace
+}  // namespace posefair
+
+namespace posefair {
+namespace {
+
+// What the constructor keeps on the heap, measured by the counting allocator, against what
+// memory_bytes() reports ("bytes held for this stream, all of it allocated at construction").
+struct Held {
+  std::ptrdiff_t heap;
+  std::size_t reported;
+};
+
+Held held_by(const WindowConfig& c) {
+  const std::ptrdiff_t before = live_bytes();
+  auto* w = new FairingWindow(c);  // on the heap, so sizeof(FairingWindow) is counted as well
+  const Held h{live_bytes() - before, w->memory_bytes()};
+  delete w;
+  return h;
+}
+
+TEST(WindowAllocation, MemoryBytesAccountsForTheHeapTheWindowHolds) {
+  // Configurations without the linear solver's precomputed rows (see the disabled test below).
+  for (WindowSolver solver : {WindowSolver::GaussNewton, WindowSolver::DampedSweeps}) {
+    for (int window : {8, 32, 128}) {
+      WindowConfig c;
+      c.solver = solver;
+      c.window = window;
+      c.lag = 2;
+      const Held h = held_by(c);
+      EXPECT_GE(static_cast<std::ptrdiff_t>(h.reported), h.heap) << "window " << window;
+      EXPECT_LE(static_cast<std::ptrdiff_t>(h.reported), h.heap + h.heap / 10) << "window " << window;
+    }
+  }
+}
+
+// KNOWN BUG (reported, not fixed here): memory_bytes() leaves out the precomputed emission rows
+// row_zeta_, row_c_, row_p_ (O(W²) doubles, allocated in the constructor for the linear solver
+// and for any solver with continuity > 0), although docs/engine.md says it reports them.
+TEST(WindowAllocation, DISABLED_MemoryBytesIncludesThePrecomputedRows) {
+  WindowConfig linear;
+  linear.window = 32;
+  WindowConfig gn_continuity = linear;
+  gn_continuity.solver = WindowSolver::GaussNewton;
+  gn_continuity.continuity = 0.5;
+  for (const WindowConfig& c : {linear, gn_continuity}) {
+    const Held h = held_by(c);
+    EXPECT_GE(static_cast<std::ptrdiff_t>(h.reported), h.heap) << static_cast<int>(c.solver);
+  }
+}
+
+}  // namespace
+}  // namespace posefair
