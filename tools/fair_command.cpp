@@ -19,6 +19,7 @@
 #include "exit_codes.hpp"
 #include "posefair/core/causal_fairing.hpp"
 #include "posefair/core/fairing.hpp"
+#include "posefair/core/quality_metrics.hpp"
 #include "posefair/drivers/pose_file.hpp"
 
 namespace posefair::tools {
@@ -41,14 +42,30 @@ struct FairOptions {
   std::optional<int> window_iterations;
 };
 
-// The median sample interval's rate: robust to gaps and a few repeated timestamps.
-double median_rate_hz(const PoseSequence& s) {
-  std::vector<double> dt;
-  for (std::size_t i = 1; i < s.size(); ++i)
-    if (s.time[i] > s.time[i - 1]) dt.push_back(s.time[i] - s.time[i - 1]);
-  if (dt.empty()) return 0.0;
-  std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
-  return 1.0 / dt[dt.size() / 2];
+// Writes the result in the input's format; on failure says why and returns EX_CANTCREAT.
+int write_output(const FairOptions& o, const drivers::PoseFile& file, const PoseSequence& poses) {
+  try {
+    drivers::write_pose_file(o.output, file, poses);
+  } catch (const drivers::PoseFileError& e) {
+    std::cerr << "posefair fair: " << e.what() << "\n";
+    return kExitCantCreate;
+  }
+  return kExitOk;
+}
+
+void print_input_line(const FairOptions& o, const drivers::PoseFile& file, const char* rate_kind, double rate) {
+  const PoseSequence& in = file.poses();
+  std::printf("input    %s: %zu samples, %s, %s, %.1f Hz %s rate", o.input.c_str(), in.size(),
+              std::string(drivers::to_string(file.format())).c_str(),
+              in.has_position() ? "orientation + position" : "orientation only", rate, rate_kind);
+  if (file.skipped_rows() > 0) std::printf(", %zu rows without orientation skipped", file.skipped_rows());
+  std::printf("\n");
+}
+
+void print_deviation_line(double max_dist_r, bool with_position, double max_deviation_t) {
+  std::printf("max dev  rotation %.6g rad (%.4g deg)", 2.0 * max_dist_r, 2.0 * max_dist_r * 180.0 / std::numbers::pi);
+  if (with_position) std::printf(", position %.6g", max_deviation_t);
+  std::printf("\n");
 }
 
 int run_causal(const FairOptions& o, const drivers::PoseFile& file) {
@@ -61,7 +78,7 @@ int run_causal(const FairOptions& o, const drivers::PoseFile& file) {
   c.lambda_t = o.params.lambda_t;
   c.variant = o.params.variant;
   if (o.window_iterations) c.iterations = *o.window_iterations;
-  const double rate = median_rate_hz(in);
+  const double rate = median_sample_rate(in.time);
   if (o.smoothing) c.smoothing_r = c.smoothing_t = *o.smoothing;
   if (o.cutoff_hz) {
     try {
@@ -80,17 +97,10 @@ int run_causal(const FairOptions& o, const drivers::PoseFile& file) {
   const auto t0 = std::chrono::steady_clock::now();
   const CausalResult r = fair_causal(in, c);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  try {
-    drivers::write_pose_file(o.output, file, r.poses);
-  } catch (const drivers::PoseFileError& e) {
-    std::cerr << "posefair fair: " << e.what() << "\n";
-    return kExitCantCreate;
-  }
+  if (const int rc = write_output(o, file, r.poses); rc != kExitOk) return rc;
   if (!o.quiet) {
     const char* solver = c.solver == WindowSolver::Linear ? "linear" : c.solver == WindowSolver::GaussNewton ? "gauss-newton" : "sweeps";
-    std::printf("input    %s: %zu samples, %s, %s, %.1f Hz median rate\n", o.input.c_str(), in.size(),
-                std::string(drivers::to_string(file.format())).c_str(),
-                in.has_position() ? "orientation + position" : "orientation only", rate);
+    print_input_line(o, file, "median", rate);
     std::printf("causal   m=%d, %s solver, window %d, lag %d (%.3g ms), iterations %d, mu_r %.6g, continuity %g, bound per %s\n",
                 c.order, solver, c.window, c.lag, rate > 0 ? 1000.0 * c.lag / rate : 0.0, c.iterations, c.smoothing_r,
                 c.continuity, c.bound == BoundPolicy::Sample ? "sample" : "window");
@@ -98,17 +108,12 @@ int run_causal(const FairOptions& o, const drivers::PoseFile& file) {
                 static_cast<unsigned long long>(r.counters.emitted), static_cast<unsigned long long>(r.counters.clamped),
                 static_cast<unsigned long long>(r.counters.restarts), static_cast<unsigned long long>(r.gate.dropped()),
                 static_cast<unsigned long long>(r.gate.rejected()));
-    std::printf("max dev  rotation %.6g rad (%.4g deg)", 2.0 * r.max_dist_r, 2.0 * r.max_dist_r * 180.0 / std::numbers::pi);
-    if (in.has_position()) std::printf(", position %.6g", r.max_deviation_t);
-    std::printf("\ncost     %.0f ns per sample\nwrote    %s\n", 1e9 * seconds / std::max<std::size_t>(1, in.size()), o.output.c_str());
+    print_deviation_line(r.max_dist_r, in.has_position(), r.max_deviation_t);
+    std::printf("cost     %.0f ns per sample\nwrote    %s\n", 1e9 * seconds / std::max<std::size_t>(1, in.size()), o.output.c_str());
   }
   return kExitOk;
 }
 
-double mean_rate_hz(const PoseSequence& s) {
-  if (s.size() < 2 || s.time.back() <= s.time.front()) return 0.0;
-  return static_cast<double>(s.size() - 1) / (s.time.back() - s.time.front());
-}
 
 int run_fair(FairOptions o) {
   {
@@ -138,19 +143,11 @@ int run_fair(FairOptions o) {
   const PoseSequence& in = file.poses();
   try {
     const FairingResult r = fair(in, o.params);
-    try {
-      drivers::write_pose_file(o.output, file, r.poses);
-    } catch (const drivers::PoseFileError& e) {
-      std::cerr << "posefair fair: " << e.what() << "\n";
-      return kExitCantCreate;
-    }
+    if (const int rc = write_output(o, file, r.poses); rc != kExitOk) return rc;
     if (!o.quiet) {
       const int m = o.params.order;
-      std::printf("input    %s: %zu samples, %s, %s, %.1f Hz mean rate", o.input.c_str(), in.size(),
-                  std::string(drivers::to_string(file.format())).c_str(),
-                  in.has_position() ? "orientation + position" : "orientation only", mean_rate_hz(in));
-      if (file.skipped_rows() > 0) std::printf(", %zu rows without orientation skipped", file.skipped_rows());
-      std::printf("\nfairing  m=%d, %s operators, lambda_r=%g lambda_t=%g, eps_r=%g rad eps_t=%g, cap %d\n", m,
+      print_input_line(o, file, "median", median_sample_rate(in.time));
+      std::printf("fairing  m=%d, %s operators, lambda_r=%g lambda_t=%g, eps_r=%g rad eps_t=%g, cap %d\n", m,
                   o.params.variant == OperatorVariant::Printed ? "printed" : "corrected", o.params.lambda_r,
                   o.params.lambda_t, o.eps_r_rotation, o.params.epsilon_t, o.params.max_iterations);
       std::printf("stopped  after %d iterations: %s\n", r.iterations, std::string(to_string(r.stop)).c_str());
@@ -160,10 +157,9 @@ int run_fair(FairOptions o) {
         std::printf("   E%d_t %.6g -> %.6g (x%.3g)", m, r.translational_energy_before, r.translational_energy_after,
                     r.translational_energy_before > 0 ? r.translational_energy_after / r.translational_energy_before
                                                       : 1.0);
-      std::printf("\nmax dev  rotation %.6g rad (%.4g deg)", 2.0 * r.max_dist_r,
-                  2.0 * r.max_dist_r * 180.0 / std::numbers::pi);
-      if (in.has_position()) std::printf(", position %.6g", r.max_deviation_t);
-      std::printf("\nwrote    %s\n", o.output.c_str());
+      std::printf("\n");
+      print_deviation_line(r.max_dist_r, in.has_position(), r.max_deviation_t);
+      std::printf("wrote    %s\n", o.output.c_str());
     }
     return kExitOk;
   } catch (const std::invalid_argument& e) {

@@ -15,14 +15,6 @@
 namespace posefair::tools {
 namespace {
 
-double median_rate(const std::vector<double>& t) {
-  std::vector<double> dt;
-  for (std::size_t i = 1; i < t.size(); ++i)
-    if (t[i] > t[i - 1]) dt.push_back(t[i] - t[i - 1]);
-  std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
-  return 1.0 / dt[dt.size() / 2];
-}
-
 // Smooth truth plus bounded noise (Section 6 style), 10 s (quick: 3 s).
 QualityDataset synthetic(double rate, double noise, bool quick) {
   SyntheticMotionSpec spec;
@@ -66,7 +58,7 @@ QualityDataset tum(const std::filesystem::path& est_path, const std::filesystem:
   }
   const FrameAlignment a = align_frames(d.input.orientation, d.truth, true);
   for (Quat& q : d.truth) q = (a.world.conjugate() * q * a.body.conjugate()).normalized();
-  d.rate_hz = median_rate(d.input.time);
+  d.rate_hz = median_sample_rate(d.input.time);
   d.use.assign(d.input.size(), 1);
   return d;
 }
@@ -110,7 +102,7 @@ QualityDataset broad(const std::filesystem::path& path, const std::string& name)
     d.gyro.emplace_back(v[8], v[9], v[10]);
     d.use.push_back(v[movement_col] > 0.5 ? 1 : 0);
   }
-  d.rate_hz = median_rate(d.input.time);
+  d.rate_hz = median_sample_rate(d.input.time);
   // A rate interval is scored only if both ends are consecutive samples (no dropout between).
   for (std::size_t i = 0; i + 1 < d.input.size(); ++i)
     if (d.input.time[i + 1] - d.input.time[i] > 1.5 / d.rate_hz) d.use[i] = 0;
@@ -134,7 +126,7 @@ QualityDataset bvh(const std::filesystem::path& path, const std::string& joint, 
     d.truth.push_back(clean.orientation[i]);
     d.input.orientation.push_back((clean.orientation[i] * so3::exp(dir * noise * u(rng))).normalized());
   }
-  d.rate_hz = median_rate(d.input.time);
+  d.rate_hz = median_sample_rate(d.input.time);
   d.use.assign(d.input.size(), 1);
   return d;
 }
