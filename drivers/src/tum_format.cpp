@@ -61,19 +61,7 @@ std::string render_tum(const PoseFile& original, const PoseSequence& poses) {
   }
   const PoseSequence& old = original.poses();
   std::vector<Edit> edits;
-  for (std::size_t k = 0; k < poses.size(); ++k) {
-    const PoseSpans& row = doc.rows[k];
-    if (!same_value(poses.time[k], old.time[k])) edits.push_back({row.time, format_number(poses.time[k])});
-    const Quat& q = poses.orientation[k];
-    if (!same_value(q, old.orientation[k])) {
-      const double v[4] = {q.w(), q.x(), q.y(), q.z()};
-      for (int i = 0; i < 4; ++i) edits.push_back({row.quat[i], format_number(v[i])});
-    }
-    if (poses.has_position())
-      for (int i = 0; i < 3; ++i)
-        if (!same_value(poses.position[k][i], old.position[k][i]))
-          edits.push_back({row.pos[i], format_number(poses.position[k][i])});
-  }
+  append_pose_edits(doc, old, poses, edits);
   return apply_edits(doc.text, std::move(edits));
 }
 

@@ -6,14 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <numbers>
 #include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
-#include <unistd.h>
 
+#include "drivers_test_support.hpp"
 #include "posefair/drivers/euler_angles.hpp"
 #include "posefair/drivers/pose_file.hpp"
 
@@ -33,36 +32,8 @@ ReadOptions joint(const std::string& name) {
   return o;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("posefair_bvh_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
 PoseFileError error_of(const std::string& text, const ReadOptions& options) {
-  try {
-    parse_pose_text(text, "walk.bvh", options);
-  } catch (const PoseFileError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error for:\n" << text;
-  return PoseFileError("", 0, "");
+  return parse_error(text, "walk.bvh", options);
 }
 
 // Hand-written elementary rotations (degrees).

@@ -5,11 +5,10 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 
+#include "drivers_test_support.hpp"
 #include "posefair/drivers/pose_file.hpp"
 
 namespace posefair::drivers {
@@ -22,54 +21,10 @@ using ::testing::Not;
 const std::string kBroad = POSEFAIR_SHARED_DIR "/data/broad/07_undisturbed_fast_rotation_B.csv";
 const std::string kData = POSEFAIR_SOURCE_DIR "/tests/drivers/data/";
 
-ReadOptions csv() {
-  ReadOptions o;
-  o.format = PoseFormat::Csv;
-  return o;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("posefair_csv_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+ReadOptions csv() { return read_as(PoseFormat::Csv); }
 
 PoseFileError error_of(const std::string& text, const ReadOptions& options = csv()) {
-  try {
-    parse_pose_text(text, "walk.csv", options);
-  } catch (const PoseFileError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error for:\n" << text;
-  return PoseFileError("", 0, "");
-}
-
-void expect_identical(const PoseSequence& a, const PoseSequence& b) {
-  ASSERT_EQ(a.size(), b.size());
-  ASSERT_EQ(a.position.size(), b.position.size());
-  for (std::size_t k = 0; k < a.size(); ++k) {
-    ASSERT_EQ(a.time[k], b.time[k]) << k;
-    ASSERT_EQ(a.orientation[k].coeffs(), b.orientation[k].coeffs()) << k;
-    if (a.has_position()) {
-      ASSERT_EQ(a.position[k], b.position[k]) << k;
-    }
-  }
+  return parse_error(text, "walk.csv", options);
 }
 
 TEST(CsvFormat, WFirstAndWLastHeadersGiveTheSameQuaternions) {

@@ -5,11 +5,9 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
-#include <unistd.h>
 
+#include "drivers_test_support.hpp"
 #include "posefair/drivers/pose_file.hpp"
 
 namespace posefair::drivers {
@@ -21,55 +19,10 @@ using ::testing::HasSubstr;
 const std::string kShared = POSEFAIR_SHARED_DIR "/data/tum/";
 const std::string kData = POSEFAIR_SOURCE_DIR "/tests/drivers/data/";
 
-ReadOptions tum() {
-  ReadOptions o;
-  o.format = PoseFormat::Tum;
-  return o;
-}
+ReadOptions tum() { return read_as(PoseFormat::Tum); }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("posefair_tum_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-// The error a text raises, or a failure when it raises none.
 PoseFileError error_of(const std::string& text, const ReadOptions& options = tum()) {
-  try {
-    parse_pose_text(text, "walk.txt", options);
-  } catch (const PoseFileError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no error for:\n" << text;
-  return PoseFileError("", 0, "");
-}
-
-void expect_identical(const PoseSequence& a, const PoseSequence& b) {
-  ASSERT_EQ(a.size(), b.size());
-  ASSERT_EQ(a.position.size(), b.position.size());
-  for (std::size_t k = 0; k < a.size(); ++k) {
-    ASSERT_EQ(a.time[k], b.time[k]) << k;
-    ASSERT_EQ(a.orientation[k].coeffs(), b.orientation[k].coeffs()) << k;
-    if (a.has_position()) {
-      ASSERT_EQ(a.position[k], b.position[k]) << k;
-    }
-  }
+  return parse_error(text, "walk.txt", options);
 }
 
 TEST(TumFormat, ReadsTheRealFiles) {

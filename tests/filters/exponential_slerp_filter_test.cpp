@@ -8,31 +8,17 @@
 
 #include <gtest/gtest.h>
 
+#include "filter_test_support.hpp"
+
 namespace posefair {
 namespace {
 
-// Signed physical angle of q about `axis` (q assumed to be a rotation about that axis, w > 0 side).
-double angle_about(const Quat& q, const Vec3& axis) { return 2.0 * std::atan2(q.vec().dot(axis), q.w()); }
-
-Quat random_unit_quaternion(std::mt19937_64& rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  Eigen::Vector4d c(n(rng), n(rng), n(rng), n(rng));
-  c.normalize();
-  return Quat(c(3), c(0), c(1), c(2));
-}
+using testing::angle_about;
+using testing::random_unit_quaternion;
 
 std::vector<Quat> noisy_rotation_stream(std::uint64_t seed, int n, double dt) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> noise(0.0, 0.05);
-  const Quat base = random_unit_quaternion(rng);
-  std::vector<Quat> out;
-  for (int k = 0; k < n; ++k) {
-    const double t = k * dt;
-    const Vec3 r(2.0 * std::sin(1.1 * t), 1.5 * std::cos(0.7 * t), 2.8 * std::sin(0.3 * t + 0.5));
-    const Vec3 jitter(noise(rng), noise(rng), noise(rng));
-    out.push_back(base * so3::from_rotation_vector(r) * so3::from_rotation_vector(jitter));
-  }
-  return out;
+  return testing::noisy_rotation_stream(
+      seed, n, dt, {Vec3(2.0, 1.5, 2.8), Vec3(1.1, 0.7, 0.3), /*phase=*/0.5, /*noise=*/0.05});
 }
 
 TEST(ExponentialSlerp, StepResponseAfterNStepsIsGeometric) {

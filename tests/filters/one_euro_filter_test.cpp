@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include "filter_test_support.hpp"
+
 namespace posefair {
 namespace {
 
@@ -60,8 +62,8 @@ void load_ground_truth(std::vector<GroundTruthRow>& rows) {
 // ---------------------------------------------------------------------------------------------
 // Helpers
 
-// Signed physical angle of q about `axis` (q assumed to be a rotation about that axis, w > 0 side).
-double angle_about(const Quat& q, const Vec3& axis) { return 2.0 * std::atan2(q.vec().dot(axis), q.w()); }
+using testing::angle_about;
+using testing::random_unit_quaternion;
 
 // A noisy random walk in angle with jittered sample times, for fixed-axis comparisons.
 struct Stream {
@@ -83,26 +85,10 @@ Stream jittered_stream(std::uint64_t seed, int n, double amplitude) {
   return s;
 }
 
-Quat random_unit_quaternion(std::mt19937_64& rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  Eigen::Vector4d c(n(rng), n(rng), n(rng), n(rng));
-  c.normalize();
-  return Quat(c(3), c(0), c(1), c(2));
-}
-
 // A smoothly moving, noisy orientation stream covering large angles.
 std::vector<Quat> noisy_rotation_stream(std::uint64_t seed, int n, double dt) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> noise(0.0, 0.03);
-  const Quat base = random_unit_quaternion(rng);
-  std::vector<Quat> out;
-  for (int k = 0; k < n; ++k) {
-    const double t = k * dt;
-    const Vec3 r(2.5 * std::sin(0.9 * t), 1.7 * std::cos(1.3 * t), 3.0 * std::sin(0.4 * t + 1.0));
-    const Vec3 jitter(noise(rng), noise(rng), noise(rng));
-    out.push_back(base * so3::from_rotation_vector(r) * so3::from_rotation_vector(jitter));
-  }
-  return out;
+  return testing::noisy_rotation_stream(
+      seed, n, dt, {Vec3(2.5, 1.7, 3.0), Vec3(0.9, 1.3, 0.4), /*phase=*/1.0, /*noise=*/0.03});
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -148,6 +148,14 @@ struct Edit {
 // text with every edit applied (edits must not overlap; any order).
 std::string apply_edits(std::string_view text, std::vector<Edit> edits);
 
+// ---- TUM/CSV pose edits (pose_edits.cpp) ----
+
+// Appends one edit per changed value of each row of doc.rows (TUM and CSV): the time, all four
+// quaternion fields (w, x, y, z spans) when the orientation changed, and each changed position
+// field when `poses` has positions. `old` is the sequence the document was read as.
+void append_pose_edits(const Document& doc, const PoseSequence& old, const PoseSequence& poses,
+                       std::vector<Edit>& edits);
+
 // ---- the formats ----
 
 PoseFile parse_tum(std::string text, const std::string& name, const ReadOptions& options);
