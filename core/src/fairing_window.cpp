@@ -11,23 +11,38 @@
 namespace posefair {
 namespace {
 
-// Moves x onto the ball of radius eps around z (distance on S³ for rotations) if it is outside.
-// The radius is shrunk by a relative 1e-9 so rounding cannot carry the result past eps.
+// Moves x onto the ball of radius eps around z (distance on S³ for rotations) if it is outside,
+// and checks the result with the same distance the promise is stated in: the radius is shrunk
+// step by step until rounding can no longer carry the result past eps (an absolute rounding of
+// ulp(|z|) defeats any fixed relative margin for positions far from the origin, or for a tiny
+// eps), and as a last resort the measurement itself is used.
 bool project_rotation(const Quat& z, Quat& x, double eps) {
+  if (!std::isfinite(eps) || so3::dist(z, x) <= eps) return false;
   const Vec3 v = so3::log(z.conjugate() * x);
   const double r = v.norm();
-  const double limit = eps * (1.0 - 1e-9);
-  if (r <= limit) return false;
-  x = so3::aligned_to((z * so3::exp(v * (limit / r))).normalized(), x);
+  for (double shrink : {1e-12, 1e-9, 1e-6, 1e-3}) {
+    const Quat c = so3::aligned_to((z * so3::exp(v * (eps * (1.0 - shrink) / r))).normalized(), x);
+    if (so3::dist(z, c) <= eps) {
+      x = c;
+      return true;
+    }
+  }
+  x = so3::aligned_to(z, x);
   return true;
 }
 
 bool project_position(const Vec3& z, Vec3& p, double eps) {
+  if (!std::isfinite(eps) || (p - z).norm() <= eps) return false;
   const Vec3 d = p - z;
   const double r = d.norm();
-  const double limit = eps * (1.0 - 1e-9);
-  if (r <= limit) return false;
-  p = z + d * (limit / r);
+  for (double shrink : {1e-12, 1e-9, 1e-6, 1e-3}) {
+    const Vec3 c = z + d * (eps * (1.0 - shrink) / r);
+    if ((c - z).norm() <= eps) {
+      p = c;
+      return true;
+    }
+  }
+  p = z;
   return true;
 }
 
@@ -213,22 +228,14 @@ int FairingWindow::first_unemitted() const { return std::max(0, n_ - config_.lag
 
 FairedPose FairingWindow::emit(int index) {
   const auto k = static_cast<std::size_t>(index);
-  Quat q;
-  bool clamped = false;
-  if (config_.solver == WindowSolver::Linear) {
-    // x = z exp(e): the ε projection is a clamp of ‖e‖ (dist(z, x) = ‖e‖ for ‖e‖ ≤ π/2).
-    Vec3 e = est_[k];
-    const double r = e.norm(), limit = std::min(config_.epsilon_r, std::numbers::pi / 2) * (1.0 - 1e-9);
-    if (r > limit) {
-      e *= limit / r;
-      clamped = true;
-    }
-    c_[k] = e;
-    q = (z_[k] * so3::exp(e)).normalized();
-  } else {
-    q = x_[k];
-    clamped = project_rotation(z_[k], q, config_.epsilon_r);
-  }
+  Quat q = config_.solver == WindowSolver::Linear ? Quat((z_[k] * so3::exp(est_[k])).normalized()) : x_[k];
+  bool clamped = project_rotation(z_[k], q, config_.epsilon_r);
+  // The stream stays hemisphere-continuous across window restarts too.
+  if (have_emitted_) q = so3::aligned_to(q, last_emitted_);
+  last_emitted_ = q;
+  have_emitted_ = true;
+  // The linear solver's continuity term needs the emitted correction log(z⁻¹ y).
+  if (config_.solver == WindowSolver::Linear && config_.continuity > 0.0) c_[k] = so3::log(z_[k].conjugate() * q);
   Vec3 p = xp_[k];
   if (positions_) clamped = project_position(zp_[k], p, config_.epsilon_t) || clamped;
   if (clamped) ++counters_.clamped;

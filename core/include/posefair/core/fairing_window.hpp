@@ -19,7 +19,7 @@
 // The bound ε is a hard promise on every emitted pose: dist(output, measurement) ≤ ε_r (dist on
 // S³, half the rotation angle) and ‖p − p_measured‖ ≤ ε_t, enforced by projecting onto the
 // ε-ball either at emission only (BoundPolicy::Sample) or for every window sample after every
-// iteration (BoundPolicy::Window).
+// iteration (BoundPolicy::Window), and checked in the distance the promise is stated in.
 // Memory is fixed at construction; push() and flush() never allocate.
 #include <cstdint>
 #include <limits>
@@ -113,6 +113,8 @@ class FairingWindow {
   WindowCounters counters_;
   int n_ = 0;              // samples in the window
   bool positions_ = false; // this window carries positions (all its samples do)
+  bool have_emitted_ = false;
+  Quat last_emitted_ = Quat::Identity();
 
   // Per sample, index 0 = oldest.
   std::vector<Sample> samples_;   // as accepted (time, ids, measured values with their own sign)
