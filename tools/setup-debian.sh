@@ -11,6 +11,7 @@ packages=(
   googletest libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # benchmarks
   libcli11-dev           # the posefair command line
+  zlib1g-dev             # CRC-32 of the sample log (drivers)
 )
 if [[ "${1:-}" == "--plots" ]]; then
   packages+=(python3 python3-matplotlib python3-numpy)

@@ -100,6 +100,7 @@ FairingWindow::FairingWindow(const WindowConfig& config) : config_(config), gate
   x_.resize(w);
   zeta_.resize(w);
   est_.resize(w);
+  window_clamped_.assign(w, 0);
   c_.resize(w);
   y_.resize(w);
   zp_.resize(w);
@@ -216,7 +217,11 @@ std::size_t FairingWindow::memory_bytes() const {
   bytes += (zeta_.capacity() + est_.capacity() + c_.capacity()) * sizeof(Vec3);
   bytes += (zp_.capacity() + xp_.capacity() + yp_.capacity() + e_.capacity() + u_.capacity() + w_.capacity() +
             rhs_.capacity()) * sizeof(Vec3);
-  bytes += diag_.capacity() * sizeof(double);
+  bytes += diag_.capacity() * sizeof(double) + window_clamped_.capacity();
+  for (const auto* rows : {&row_zeta_, &row_c_, &row_p_}) {
+    bytes += rows->capacity() * sizeof(std::vector<double>);
+    for (const auto& r : *rows) bytes += r.capacity() * sizeof(double);
+  }
   for (const auto* set : {&factors_r_, &factors_t_}) {
     bytes += set->capacity() * sizeof(BandedCholesky);
     for (const BandedCholesky& f : *set) bytes += static_cast<std::size_t>(f.size() * (f.bandwidth() + 1)) * sizeof(double);
@@ -238,7 +243,8 @@ FairedPose FairingWindow::emit(int index) {
   if (config_.solver == WindowSolver::Linear && config_.continuity > 0.0) c_[k] = so3::log(z_[k].conjugate() * q);
   Vec3 p = xp_[k];
   if (positions_) clamped = project_position(zp_[k], p, config_.epsilon_t) || clamped;
-  if (clamped) ++counters_.clamped;
+  // With the window policy the projection may already have happened inside the solve.
+  if (clamped || window_clamped_[k]) ++counters_.clamped;
   y_[k] = q;
   yp_[k] = p;
   ++counters_.emitted;
@@ -300,6 +306,7 @@ void FairingWindow::append(const Sample& s) {
     } else {
       std::move(x_.begin() + 1, x_.end(), x_.begin());
       std::move(y_.begin() + 1, y_.end(), y_.begin());
+      std::move(window_clamped_.begin() + 1, window_clamped_.end(), window_clamped_.begin());
     }
     if (positions_) {
       std::move(zp_.begin() + 1, zp_.end(), zp_.begin());
@@ -310,6 +317,7 @@ void FairingWindow::append(const Sample& s) {
   }
   const auto k = static_cast<std::size_t>(n_);
   samples_[k] = s;
+  window_clamped_[k] = 0;
   Quat z = s.orientation;
   if (n_ == 0) {
     if (z.w() < 0.0) z.coeffs() = -z.coeffs();
@@ -431,8 +439,9 @@ void FairingWindow::sweeps() {
 void FairingWindow::bound_window() {
   for (int i = 0; i < n_; ++i) {
     const auto k = static_cast<std::size_t>(i);
-    project_rotation(z_[k], x_[k], config_.epsilon_r);
-    if (positions_) project_position(zp_[k], xp_[k], config_.epsilon_t);
+    bool moved = project_rotation(z_[k], x_[k], config_.epsilon_r);
+    if (positions_) moved = project_position(zp_[k], xp_[k], config_.epsilon_t) || moved;
+    if (moved) window_clamped_[k] = 1;
   }
 }
 

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "../core/test_sequences.hpp"
 #include "engine_test_support.hpp"
 #include "posefair/core/fairing_window.hpp"
 
@@ -317,6 +318,29 @@ TEST(FairingWindowStream, SwitchingBetweenPositionsAndOrientationOnlyRestartsThe
       EXPECT_EQ(out[i].sequence, in[i].sequence);
       if (i >= 40) {
         EXPECT_EQ(out[i].position, Vec3::Zero()) << i;
+      }
+    }
+  }
+}
+
+TEST(FairingWindowStream, TheOutputStaysHemisphereContinuousAcrossAGapRestart) {
+  // FairedPose::orientation is hemisphere-continuous along the stream. Constant rotation about
+  // x by 0.02 (half-angle) per sample has w = cos(0.02 i) < 0 from i = 79 on; the window that
+  // restarts after the gap before sample 100 starts its measurements in w ≥ 0 again, and the
+  // output must not follow that flip (it used to: outputs 99 and 100 had w = -0.398, +0.416).
+  const auto q = testing::sequence_with_linear_w1(200, Quat::Identity(), Vec3(0.02, 0.0, 0.0), Vec3::Zero());
+  std::vector<Sample> in = samples_from(q);
+  for (std::size_t i = 100; i < in.size(); ++i) in[i].time += 1.0;
+  for (WindowSolver solver : kSolvers) {
+    for (int lag : {0, 3}) {
+      SCOPED_TRACE(std::string(solver_name(solver)) + " lag=" + std::to_string(lag));
+      FairingWindow w(config(solver, lag));
+      const auto out = run(w, in);
+      ASSERT_EQ(w.counters().restarts, 1u);
+      ASSERT_EQ(out.size(), in.size());
+      for (std::size_t i = 1; i < out.size(); ++i) {
+        ASSERT_GE(out[i].orientation.dot(out[i - 1].orientation), 0.0) << i;
+        ASSERT_LT(so3::dist(out[i].orientation, q[i]), 1e-9) << i;  // noiseless: unchanged
       }
     }
   }

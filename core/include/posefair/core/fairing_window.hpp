@@ -123,6 +123,7 @@ class FairingWindow {
   std::vector<Vec3> zeta_;        // ζ_j = log(z_j⁻¹ z_{j+1}) (Linear)
   std::vector<Vec3> est_;         // e_i: estimate x_i = z_i exp(e_i) (Linear)
   std::vector<Vec3> c_;           // log(z_i⁻¹ y_i) of emitted samples (Linear)
+  std::vector<char> window_clamped_;  // the window bound moved this sample during a solve
   std::vector<Quat> y_;           // what was emitted (valid for emitted indices)
   std::vector<Vec3> zp_, xp_, yp_;
   // Scratch.
