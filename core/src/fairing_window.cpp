@@ -71,6 +71,8 @@ void validate(const WindowConfig& c) {
   if (c.lag < 0 || c.lag >= c.window)
     bad("lag must be in [0, window-1] = [0, " + std::to_string(c.window - 1) + "], got " + std::to_string(c.lag));
   if (c.iterations < 0 || c.iterations > 1000) bad("iterations must be in [0, 1000], got " + std::to_string(c.iterations));
+  if (c.iterations == 0 && c.solver == WindowSolver::GaussNewton)
+    bad("iterations must be at least 1 for the gauss-newton solver (0 would emit the warm-start extrapolation)");
   // Beyond about 1e10 the window is already an exact polynomial fit and the system only loses
   // precision (I + μDᵀD becomes numerically singular).
   if (!(c.smoothing_r >= 0.0 && c.smoothing_r <= kMaxSmoothing)) bad("smoothing_r must be in [0, 1e10], got " + std::to_string(c.smoothing_r));

@@ -114,7 +114,8 @@ TEST(FairingWindowBound, EveryEmittedPoseStaysWithinEpsilonOfItsMeasurement) {
 
 TEST(FairingWindowBound, ClampedOutputsLieOnTheBoundaryNotInsideIt) {
   // With ε far below the noise, a clamped pose is the point of the ε-ball nearest the
-  // estimate: it sits on the sphere of radius ε (minus the documented 1e-9 relative margin).
+  // estimate: it sits on the sphere of radius ε (up to the projection's tiny safety margin),
+  // not somewhere inside the ball.
   const auto motion = noisy_motion(41, true, 300, 0.05, 10.0);
   const auto in = samples_from(motion.noisy);
   for (WindowSolver solver : {WindowSolver::Linear, WindowSolver::GaussNewton}) {

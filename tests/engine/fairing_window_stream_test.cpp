@@ -26,7 +26,7 @@ WindowConfig config(WindowSolver solver, int lag, double continuity = 0.0) {
   WindowConfig c = testing::smoothing_config(solver, 2, lag);
   c.window = 16;
   c.continuity = continuity;
-  c.epsilon_r = 0.04;  // keeps the sweeps anchored to the data
+  c.epsilon_r = 0.04;  // the projections take part in every stream test
   c.epsilon_t = 8.0;
   return c;
 }

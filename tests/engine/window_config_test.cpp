@@ -157,3 +157,18 @@ TEST(SmoothingForCutoff, TheSteadyStateSmootherPassesHalfTheAmplitudeAtTheCutoff
 
 }  // namespace
 }  // namespace posefair
+
+namespace posefair {
+namespace {
+
+TEST(WindowConfig, GaussNewtonNeedsAtLeastOneIteration) {
+  WindowConfig c;
+  c.solver = WindowSolver::GaussNewton;
+  c.iterations = 0;
+  EXPECT_THROW(validate(c), std::invalid_argument);
+  c.solver = WindowSolver::Linear;  // the linear solver ignores iterations
+  EXPECT_NO_THROW(validate(c));
+}
+
+}  // namespace
+}  // namespace posefair

@@ -12,7 +12,8 @@
 //     sample, with the Cholesky factor computed at construction. Neglects terms of order
 //     ‖ζ‖·‖e‖ (motion per sample times correction).
 //   GaussNewton: the same normal equations relinearised at the current estimate each
-//     iteration (warm-started from the previous window), converging to the exact minimiser.
+//     iteration (warm-started from the previous window), with the Jacobians of log taken as
+//     the identity: its fixed point differs from the exact minimiser by second-order terms.
 //   DampedSweeps: K of the paper's damped operator sweeps (eqs. 16–18) per sample: the reference.
 // Positions are linear and solved exactly by Linear and GaussNewton.
 // docs/engine.md derives the solvers and compares them.
@@ -61,7 +62,7 @@ inline constexpr double kMaxSmoothing = 1e10;
 // refuses a continuity κ > 0 that would make the output recursion unstable.
 void validate(const WindowConfig& config);
 
-// μ for which the steady-state Whittaker smoother I + μ(D^m)ᵀD^m halves the power at
+// μ for which the steady-state Whittaker smoother I + μ(D^m)ᵀD^m has gain 1/2 (−6 dB) at
 // cutoff_hz for samples at rate_hz: μ = (2 sin(π f_c / f_s))^(−2m).
 double smoothing_for_cutoff(double cutoff_hz, double rate_hz, int order);
 
