@@ -5,6 +5,7 @@
 #include "exit_codes.hpp"
 #include "fair_command.hpp"
 #include "reproduce_command.hpp"
+#include "sub_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"posefair: smooth orientation streams with Lee & Shin motion fairing"};
@@ -14,6 +15,7 @@ int main(int argc, char** argv) {
   posefair::tools::add_fair_command(app, exit_code);
   posefair::tools::add_reproduce_command(app, exit_code);
   posefair::tools::add_bench_command(app, exit_code);
+  posefair::tools::add_sub_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -11,6 +11,7 @@ packages=(
   googletest libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # benchmarks
   libcli11-dev           # the posefair command line
+  python3                # the Python subscriber client and its test
   zlib1g-dev             # CRC-32 of the sample log (drivers)
 )
 if [[ "${1:-}" == "--plots" ]]; then
