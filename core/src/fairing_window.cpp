@@ -246,7 +246,8 @@ FairedPose FairingWindow::emit(int index) {
   Vec3 p = xp_[k];
   if (positions_) clamped = project_position(zp_[k], p, config_.epsilon_t) || clamped;
   // With the window policy the projection may already have happened inside the solve.
-  if (clamped || window_clamped_[k]) ++counters_.clamped;
+  clamped = clamped || window_clamped_[k];
+  if (clamped) ++counters_.clamped;
   y_[k] = q;
   yp_[k] = p;
   ++counters_.emitted;
@@ -259,7 +260,7 @@ FairedPose FairingWindow::emit(int index) {
   out.position = positions_ ? p : Vec3::Zero();
   out.measured = s.orientation;
   out.measured_position = s.position;
-  out.flags = s.flags;
+  out.flags = s.flags | (clamped ? kClamped : 0u);
   return out;
 }
 

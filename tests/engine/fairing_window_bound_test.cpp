@@ -1,5 +1,6 @@
 // The ε promise of FairingWindow: every emitted pose lies within ε_r (dist on S³) and ε_t of
 // the measurement it was emitted for, for every solver and bound policy.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -129,6 +130,14 @@ TEST(FairingWindowBound, ClampedOutputsLieOnTheBoundaryNotInsideIt) {
     // Uniform noise magnitude up to 0.05 against ε = 0.002: nearly every sample gets clamped.
     EXPECT_GT(w.counters().clamped, out.size() * 9 / 10);
     EXPECT_GT(on_rotation_boundary(out, c.epsilon_r), out.size() * 9 / 10);
+    // Each clamped pose says so itself (kClamped, sent on the wire), exactly as often as counted.
+    const auto flagged = std::count_if(out.begin(), out.end(), [](const FairedPose& p) { return (p.flags & kClamped) != 0; });
+    EXPECT_EQ(static_cast<std::uint64_t>(flagged), w.counters().clamped);
+    for (const FairedPose& p : out) {
+      if (so3::dist(p.orientation, p.measured) < 0.5 * c.epsilon_r) {
+        EXPECT_EQ(p.flags & kClamped, 0u);
+      }
+    }
   }
 }
 

@@ -10,6 +10,7 @@ namespace posefair {
 enum SampleFlags : std::uint32_t {
   kHasPosition = 1u << 0,
   kHasDeviceTime = 1u << 1,
+  kClamped = 1u << 2,  // FairedPose only: the ε projection moved this pose (it sits on its bound)
 };
 
 struct Sample {
@@ -35,7 +36,7 @@ struct FairedPose {
   Vec3 position = Vec3::Zero();
   Quat measured = Quat::Identity();     // the input as given (its own sign), normalised
   Vec3 measured_position = Vec3::Zero();
-  std::uint32_t flags = 0;              // the sample's flags
+  std::uint32_t flags = 0;              // the sample's flags, plus kClamped
 };
 
 }  // namespace posefair
