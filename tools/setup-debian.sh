@@ -11,6 +11,10 @@ packages=(
   googletest libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # benchmarks
   libcli11-dev           # the posefair command line
+  libtomlplusplus-dev    # posefaird's configuration files
+  libspdlog-dev          # posefaird's logging (stderr or journald)
+  libsystemd-dev         # sd_notify and the journald log sink
+  libboost-dev           # Boost.Lockfree, the ring benchmark's yardstick
   python3                # the Python subscriber client and its test
   zlib1g-dev             # CRC-32 of the sample log (drivers)
 )

@@ -166,6 +166,8 @@ struct SubOptions {
   std::string format = "text";
   std::uint64_t count = 0;    // 0 = unlimited
   double duration = 0.0;      // 0 = unlimited
+  double idle = 0.0;          // exit this long after the latest datagram (once one came); 0 = never
+  std::uint64_t every = 1;    // print every N-th pose (statistics count all)
   bool quiet = false;
   bool stats = false;
 };
@@ -281,6 +283,8 @@ int run_sub(const SubOptions& o) {
   // One byte more than the largest datagram we accept, so an oversized one is seen as such
   // even where the kernel cannot report the real size.
   std::vector<std::uint8_t> buffer(daemon::kMaxDatagramSize + 1);
+  std::optional<steady_clock::time_point> last_datagram;
+  const auto idle = duration_cast<steady_clock::duration>(duration<double>(o.idle));
   while (g_stop == 0 && (o.count == 0 || poses < o.count)) {
     milliseconds wait(200);
     if (deadline) {
@@ -288,8 +292,14 @@ int run_sub(const SubOptions& o) {
       if (left <= steady_clock::duration::zero()) break;
       wait = std::min(wait, ceil<milliseconds>(left));
     }
+    if (o.idle > 0 && last_datagram) {
+      const auto left = *last_datagram + idle - steady_clock::now();
+      if (left <= steady_clock::duration::zero()) break;
+      wait = std::min(wait, ceil<milliseconds>(left));
+    }
     const auto d = socket.receive(buffer, wait);
     if (!d) continue;
+    last_datagram = steady_clock::now();
     if (d->truncated || d->size > daemon::kMaxDatagramSize) {
       stats.reject(daemon::DecodeError::kOversized);
       continue;
@@ -301,7 +311,7 @@ int run_sub(const SubOptions& o) {
     }
     stats.observe(r.message, d->received_at);
     ++poses;
-    if (o.quiet) continue;
+    if (o.quiet || (poses - 1) % o.every != 0) continue;
     if (csv)
       print_csv(r.message, d->received_at);
     else if (json)
@@ -336,6 +346,12 @@ void add_sub_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--duration", o->duration, "exit after S seconds (0: no limit)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--idle", o->idle, "exit S seconds after the latest datagram, once one has come (0: never)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--every", o->every, "print only every N-th pose (statistics still count all)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--quiet", o->quiet, "print no poses, only the statistics");
   cmd->add_flag("--stats", o->stats, "also print one statistics line per (session, stream) at exit");
   cmd->callback([o, listen, &exit_code] {

@@ -1,0 +1,137 @@
+#pragma once
+// posefaird's configuration: what a TOML file (docs/config.md) says, validated whole before
+// anything runs. load_config() either returns a complete DaemonConfig or throws ConfigError
+// naming the file, the line and the key; the daemon exits 78 (EX_CONFIG) on it at start and
+// keeps the running configuration on it at SIGHUP. Unknown keys are errors.
+//
+// Relative paths in a config (replay sources, the recording) are resolved against the
+// directory of the config file, so a config and its data can move together.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "posefair/core/fairing_window.hpp"
+#include "posefair/daemon/overflow_policy.hpp"
+#include "posefair/daemon/udp_socket.hpp"
+#include "posefair/daemon/wire_protocol.hpp"
+#include "posefair/drivers/replay_driver.hpp"
+
+namespace posefair::daemon {
+
+// "<file>:<line>:<column>: <key>: <message>" (line and column omitted when unknown, e.g. a
+// missing required key is reported at its table's line). `key` is the dotted TOML path,
+// e.g. "stream[2].engine.window" (array elements numbered from 1 as a user counts them).
+class ConfigError : public std::runtime_error {
+ public:
+  ConfigError(std::string file, std::uint32_t line, std::uint32_t column, std::string key, std::string message);
+  const std::string& file() const noexcept { return file_; }
+  std::uint32_t line() const noexcept { return line_; }      // 0 = unknown
+  std::uint32_t column() const noexcept { return column_; }  // 0 = unknown
+  const std::string& key() const noexcept { return key_; }
+  const std::string& message() const noexcept { return message_; }
+
+ private:
+  std::string file_;
+  std::uint32_t line_;
+  std::uint32_t column_;
+  std::string key_;
+  std::string message_;
+};
+
+
+enum class LogTarget { Auto, Stderr, Journald };  // Auto: journald when JOURNAL_STREAM says stderr is the journal
+
+struct LoggingConfig {
+  std::string level = "info";  // spdlog level: trace, debug, info, warn, error, critical, off
+  LogTarget target = LogTarget::Auto;
+  double status_interval = 60.0;  // s between counter lines in the log (0: only on SIGUSR1 and exit)
+};
+
+struct DaemonSettings {
+  // Exit (status 0) once every driver has ended and every pose is out, e.g. a replay without
+  // loop. Off for a service: a finished source then just idles.
+  bool exit_when_sources_end = false;
+  // Fixed session id for the wire protocol; unset = random at start (the normal case).
+  std::optional<std::uint32_t> session_id;
+};
+
+// [stream.driver] with type = "replay": the simulated device backend.
+struct ReplaySourceConfig {
+  std::filesystem::path path;          // absolute after loading (resolved against the config's directory)
+  drivers::ReplayOptions options;      // timing, speed, schedule, loop, rounds, pose file format ...
+  // Sample logs hold several streams: which recorded stream id to play (its samples get this
+  // stream's id). Unset: the log must hold exactly one stream. Pose files: ignored.
+  std::optional<std::uint32_t> source_stream;
+};
+
+// [stream.driver] with type = "synthetic": smooth motion plus bounded noise at a fixed rate,
+// generated live (core/synthetic_motion), for demos, soak tests and the latency benchmark.
+struct SyntheticSourceConfig {
+  double rate_hz = 100.0;
+  double duration = 0.0;       // s; 0 = until stopped
+  double rotation_noise = 0.01;  // rad (dist on S³)
+  bool with_position = false;
+  std::uint64_t seed = 1;
+};
+
+enum class DriverType { Replay, Synthetic };
+
+struct DriverConfig {
+  DriverType type = DriverType::Replay;
+  ReplaySourceConfig replay;        // type == Replay
+  SyntheticSourceConfig synthetic;  // type == Synthetic
+};
+
+struct StreamConfig {
+  std::uint32_t id = 0;           // unique; the wire protocol's stream id
+  std::string name;               // unique, non-empty; for logs, STATUS= and the recording's stream table
+  DriverConfig driver;
+  std::uint32_t ring_capacity = 1024;  // samples; a power of two, 2 .. 1048576
+  OverflowPolicy overflow = OverflowPolicy::DropOldest;
+  // The engine: [engine] defaults with this stream's [stream.engine] overrides applied, already
+  // validated (posefair::validate) and in the engine's units (epsilon_r as dist on S³, i.e.
+  // half the rotation angle given in the file; smoothing from cutoff_hz when that was given).
+  WindowConfig engine;
+};
+
+struct OutputConfig {
+  WireEncoding encoding = WireEncoding::kBinary;  // "binary" or "json"
+  std::vector<Endpoint> destinations;              // unicast and multicast, IPv4 and IPv6; at least one
+  SendOptions send;                                // ttl (default 1), interface, loopback
+  std::vector<std::uint32_t> streams;              // the streams this output carries; empty = all
+  bool angular_velocity = false;  // include the body rate between consecutive emitted poses
+};
+
+struct RecorderConfig {
+  bool enabled = false;
+  std::filesystem::path path;          // absolute after loading
+  std::uint64_t max_file_bytes = 0;    // rotation; 0 = never
+  double flush_interval = 1.0;         // s
+  bool overwrite = false;              // false: refuse to start when the file exists
+  bool sync = true;                    // fdatasync after each flush
+  std::uint32_t ring_capacity = 4096;  // per stream, samples waiting for the recorder thread
+};
+
+struct DaemonConfig {
+  std::filesystem::path source_file;  // the file this was loaded from
+  DaemonSettings daemon;
+  LoggingConfig logging;
+  std::vector<StreamConfig> streams;  // at least one
+  std::vector<OutputConfig> outputs;  // may be empty (recording only)
+  RecorderConfig recorder;
+};
+
+// Parses and validates a config file. Throws ConfigError (never anything else) for an
+// unreadable file, a TOML syntax error, an unknown key, a value of the wrong type or out of
+// range, a missing required key, duplicate stream ids or names, an output naming an unknown
+// stream, an engine combination posefair::validate refuses, or a replay source that does not
+// exist.
+DaemonConfig load_config(const std::filesystem::path& file);
+
+// The same from a string (tests); `file` names it in messages and anchors relative paths.
+DaemonConfig parse_config(std::string_view text, const std::filesystem::path& file);
+
+}  // namespace posefair::daemon

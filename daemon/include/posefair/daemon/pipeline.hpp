@@ -1,0 +1,107 @@
+#pragma once
+// One running configuration of posefaird: its drivers, rings, engine, publisher and recorder.
+//
+//   driver thread (one per stream) ─► ring (SPSC, per stream) ─► engine thread ─► ring (per
+//   stream) ─► publisher thread ─► UDP;   driver thread ─► ring (per stream) ─► recorder thread
+//
+// The engine thread owns every FairingWindow and never blocks, allocates or logs; it sleeps on
+// a futex (std::atomic::wait) only when every ring is empty. The publisher is fed through
+// rings too, so a slow network cannot stall the engine. Each ring's overflow is counted.
+// A SIGHUP reload builds a new Pipeline from the new config while the old one runs, then stops
+// the old one (drained) and starts the new one: the swap is whole.
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "posefair/daemon/config.hpp"
+#include "posefair/daemon/stream_counters.hpp"
+#include "posefair/drivers/sample_log.hpp"
+
+namespace posefair::daemon {
+
+struct PipelineHooks {
+  // Called on the engine thread before each sample is faired (tests: a deliberately slow consumer).
+  std::function<void(std::uint32_t stream_id)> before_engine_sample;
+};
+
+class Pipeline {
+ public:
+  // Builds everything that can fail before anything runs: drivers (replay sources are loaded),
+  // sockets, the recording file (unless adopt_recorder() will hand one over). A recorder path
+  // containing '%' is expanded by strftime at the local time now ("run-%Y%m%d-%H%M%S.pflog"),
+  // so a service restarted by systemd starts a new file instead of refusing an existing one. Throws
+  // std::runtime_error (or std::system_error for sockets) with a message naming the stream
+  // or output. `session` and `first_sequence` continue the wire protocol across reloads.
+  Pipeline(const DaemonConfig& config, std::uint32_t session, const std::map<std::uint32_t, std::uint64_t>& first_sequence,
+           bool defer_recorder = false, PipelineHooks hooks = {});
+  ~Pipeline();
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+
+  // Starts the threads (once).
+  void start();
+  // Stops the drivers, then drains: every sample already handed over is faired, every window
+  // flushed, every pose sent, every recorded sample written and the recording synced and closed
+  // (unless keep_recorder). Idempotent.
+  void stop(bool keep_recorder = false);
+  // Every driver has returned on its own (a replay reached its end). stop() then drains the rest.
+  bool sources_ended() const;
+
+  std::vector<StreamStats> stats() const;
+  // Before start(): continue the wire sequence numbers from a stopped pipeline's (a reload).
+  void continue_sequences(const std::map<std::uint32_t, std::uint64_t>& next_sequence);
+  // The wire sequence number each stream continues from (after stop()).
+  std::map<std::uint32_t, std::uint64_t> next_sequences() const;
+  // Liveness of the engine thread for the systemd watchdog: poke, then see the heartbeat move.
+  std::uint64_t engine_heartbeat() const { return heartbeat_.load(std::memory_order_relaxed); }
+  void poke_engine();
+
+  const DaemonConfig& config() const { return config_; }
+  // Accepted damage in replay sources etc., to be logged once by the caller.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  // The recording's header (stream table) this pipeline writes or would write.
+  const drivers::SampleLogHeader& recording_header() const { return header_; }
+  // Recorder hand-over at a reload that leaves the recording unchanged: the old pipeline,
+  // stopped with keep_recorder, releases its writer; the new one, built with defer_recorder,
+  // adopts it before start().
+  std::unique_ptr<drivers::SampleLogWriter> release_recorder();
+  void adopt_recorder(std::unique_ptr<drivers::SampleLogWriter> writer);
+  // The same recording (config and stream table): a reload may hand the writer over.
+  bool same_recording(const Pipeline& other) const;
+
+ private:
+  struct Stream;
+  void engine_loop();
+  void publisher_loop();
+  void recorder_loop();
+  void wake_engine();
+  void wake_publisher();
+
+  DaemonConfig config_;
+  PipelineHooks hooks_;
+  std::vector<std::unique_ptr<Stream>> streams_;
+  std::vector<std::string> warnings_;
+  drivers::SampleLogHeader header_;
+  std::unique_ptr<class Publisher> publisher_;
+  std::unique_ptr<drivers::SampleLogWriter> writer_;
+  std::map<std::uint32_t, std::uint64_t> final_sequences_;
+
+  std::atomic<std::uint32_t> engine_wake_{0};
+  std::atomic<std::uint32_t> publisher_wake_{0};
+  std::atomic<std::uint64_t> heartbeat_{0};
+  std::atomic<bool> engine_stop_{false};
+  std::atomic<bool> publisher_stop_{false};
+  std::atomic<bool> recorder_stop_{false};
+  std::atomic<int> drivers_running_{0};
+  std::thread engine_thread_, publisher_thread_, recorder_thread_;
+  std::vector<std::jthread> driver_threads_;
+  bool started_ = false;
+  bool stopped_ = false;
+};
+
+}  // namespace posefair::daemon

@@ -1,0 +1,62 @@
+#pragma once
+// The publisher: turns faired poses into wire protocol v1 datagrams (binary or JSON lines,
+// docs/protocol.md) and sends each to every destination of every output that carries its
+// stream. Owns the per-stream wire sequence numbers (0 at session start, +1 per pose; carried
+// over a SIGHUP reload) and the previous pose per stream for the optional angular velocity.
+// Runs on the publisher thread only; sockets are non-blocking, so a slow network never stalls
+// it (a full socket buffer is a counted send failure).
+#include <cstdint>
+#include <map>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "posefair/daemon/config.hpp"
+#include "posefair/daemon/ring_items.hpp"
+#include "posefair/daemon/udp_socket.hpp"
+#include "posefair/daemon/wire_protocol.hpp"
+
+namespace posefair::daemon {
+
+class Publisher {
+ public:
+  // `stream_ids[i]` is the wire id of stream index i. `first_sequence` gives, per wire stream
+  // id, the sequence number to continue from (missing: 0). Opens the sockets now; throws
+  // std::system_error when one cannot be opened.
+  Publisher(std::uint32_t session, std::vector<std::uint32_t> stream_ids, const std::vector<OutputConfig>& outputs,
+            const std::map<std::uint32_t, std::uint64_t>& first_sequence);
+
+  struct Result {
+    bool carried = false;           // at least one output carries this stream
+    std::size_t failures = 0;       // failed sends (one per destination)
+  };
+  // Sends one pose now; send_time is CLOCK_REALTIME at the call.
+  Result publish(const RingPose& pose);
+
+  // Continue each listed stream's sequence from the given number (a reload, before any publish).
+  void continue_from(const std::map<std::uint32_t, std::uint64_t>& next_sequence);
+  // The next wire sequence number of every stream (for a reload to continue from).
+  std::map<std::uint32_t, std::uint64_t> next_sequences() const;
+  std::uint32_t session() const { return session_; }
+
+ private:
+  struct Output {
+    WireEncoding encoding;
+    bool angular_velocity;
+    std::vector<char> carries;  // per stream index
+    UdpSender sender;
+  };
+  struct StreamState {
+    std::uint32_t id = 0;
+    std::uint64_t next_sequence = 0;
+    bool have_previous = false;
+    double previous_time = 0.0;
+    Quat previous = Quat::Identity();
+  };
+  std::uint32_t session_;
+  std::vector<Output> outputs_;
+  std::vector<StreamState> streams_;
+  std::vector<std::uint8_t> binary_;  // scratch for the binary encoding
+};
+
+}  // namespace posefair::daemon

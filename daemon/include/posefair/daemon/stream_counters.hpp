@@ -1,0 +1,40 @@
+#pragma once
+// Per-stream runtime counters: written by the thread that owns each event (driver, engine,
+// publisher, recorder) with relaxed atomics, read at any time by the main thread for logs,
+// SIGUSR1 and systemd's STATUS=. Never reset while a pipeline runs; rates and interval
+// percentiles come from differences of snapshots.
+#include <atomic>
+#include <cstdint>
+#include <string>
+
+#include "posefair/daemon/latency_histogram.hpp"
+
+namespace posefair::daemon {
+
+struct StreamCounters {
+  std::atomic<std::uint64_t> received{0};         // handed over by the driver
+  std::atomic<std::uint64_t> rejected{0};         // refused by the engine's gate (NaN, zero, non-unit)
+  std::atomic<std::uint64_t> out_of_order{0};     // dropped by the gate (repeated or older time)
+  std::atomic<std::uint64_t> emitted{0};          // poses the engine produced
+  std::atomic<std::uint64_t> clamped{0};          // of which the ε projection moved
+  std::atomic<std::uint64_t> restarts{0};         // windows restarted after a gap
+  std::atomic<std::uint64_t> published{0};        // poses sent to at least one destination (or to none configured)
+  std::atomic<std::uint64_t> send_failures{0};    // failed sends (one per destination)
+  std::atomic<std::uint64_t> recorded{0};         // handed to the recorder's writer
+  LatencyHistogram latency;                       // hand-over → last datagram of the pose sent
+};
+
+// A consistent-enough copy for reporting (each field read once, relaxed).
+struct StreamStats {
+  std::uint32_t id = 0;
+  std::string name;
+  std::string driver;
+  bool driver_running = false;
+  std::uint64_t received = 0, ring_dropped = 0, rejected = 0, out_of_order = 0, emitted = 0, clamped = 0, restarts = 0;
+  std::uint64_t publish_dropped = 0, published = 0, send_failures = 0, recorded = 0, record_dropped = 0;
+  HistogramSnapshot latency;
+  // Poses lost on the way to subscribers: overflow of the engine's and the publisher's rings.
+  std::uint64_t dropped() const { return ring_dropped + publish_dropped; }
+};
+
+}  // namespace posefair::daemon

@@ -1,0 +1,756 @@
+// posefaird's TOML configuration (docs/config.md): toml++ parses, this file checks every key
+// (type, range, cross-references) and builds a DaemonConfig, or throws ConfigError naming the
+// file, line, column and dotted key of the first problem.
+#include "posefair/daemon/config.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <initializer_list>
+#include <limits>
+#include <map>
+#include <memory>
+#include <span>
+#include <string_view>
+#include <utility>
+
+#include "posefair/core/sample_gate.hpp"
+#include "posefair/daemon/wire_protocol.hpp"
+#include "posefair/drivers/pose_file.hpp"
+
+namespace posefair::daemon {
+namespace {
+
+std::string format_what(const std::string& file, std::uint32_t line, std::uint32_t column, const std::string& key,
+                        const std::string& message) {
+  std::string s = file;
+  if (line > 0) {
+    s += ':' + std::to_string(line);
+    if (column > 0) s += ':' + std::to_string(column);
+  }
+  s += ": ";
+  if (!key.empty()) s += key + ": ";
+  return s + message;
+}
+
+}  // namespace
+
+ConfigError::ConfigError(std::string file, std::uint32_t line, std::uint32_t column, std::string key,
+                         std::string message)
+    : std::runtime_error(format_what(file, line, column, key, message)),
+      file_(std::move(file)),
+      line_(line),
+      column_(column),
+      key_(std::move(key)),
+      message_(std::move(message)) {}
+
+namespace {
+
+constexpr std::int64_t kMaxU32 = std::numeric_limits<std::uint32_t>::max();
+constexpr std::int64_t kMaxI64 = std::numeric_limits<std::int64_t>::max();
+constexpr std::int64_t kMaxRingCapacity = 1 << 20;
+
+std::string number(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+std::string in_quotes(std::string_view s) { return "'" + std::string(s) + "'"; }
+
+std::string join_key(const std::string& prefix, std::string_view key) {
+  return prefix.empty() ? std::string(key) : prefix + "." + std::string(key);
+}
+
+std::string element_key(const std::string& prefix, std::size_t index0) {
+  return prefix + "[" + std::to_string(index0 + 1) + "]";
+}
+
+std::string_view type_name(toml::node_type t) {
+  switch (t) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::date: return "a date";
+    case toml::node_type::time: return "a time";
+    case toml::node_type::date_time: return "a date-time";
+    case toml::node_type::none: break;
+  }
+  return "nothing";
+}
+
+// Levenshtein distance (small strings: keys).
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// " (did you mean 'x'?)" for the nearest candidate within edit distance 2, else "".
+std::string suggestion(std::string_view word, std::span<const std::string_view> candidates) {
+  std::string_view best;
+  std::size_t best_distance = 3;
+  for (std::string_view c : candidates) {
+    const std::size_t d = edit_distance(word, c);
+    if (d < best_distance) {
+      best_distance = d;
+      best = c;
+    }
+  }
+  return best.empty() ? std::string() : " (did you mean " + in_quotes(best) + "?)";
+}
+
+bool before(const toml::source_position& a, const toml::source_position& b) {
+  return a.line != b.line ? a.line < b.line : a.column < b.column;
+}
+
+constexpr std::string_view kRootKeys[] = {"daemon", "logging", "engine", "stream", "output", "recorder"};
+constexpr std::string_view kDaemonKeys[] = {"exit_when_sources_end", "session_id"};
+constexpr std::string_view kLoggingKeys[] = {"level", "target", "status_interval"};
+constexpr std::string_view kEngineKeys[] = {
+    "window",   "lag",      "order",    "solver",    "iterations", "smoothing", "smoothing_r",
+    "smoothing_t", "cutoff_hz", "rate_hz", "continuity", "lambda_r", "lambda_t", "variant",
+    "epsilon_r", "epsilon_t", "bound",  "gap",       "unit_tolerance"};
+constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "overflow", "driver", "engine"};
+constexpr std::string_view kReplayKeys[] = {"type",   "path",   "timing",     "speed",        "schedule",     "loop",
+                                            "rounds", "format", "joint",      "csv_prefix",   "skip_missing", "source_stream"};
+constexpr std::string_view kSyntheticKeys[] = {"type", "rate_hz", "duration", "rotation_noise", "with_position", "seed"};
+constexpr std::string_view kOutputKeys[] = {"encoding", "destinations", "ttl",          "interface",
+                                            "loopback", "streams",      "angular_velocity"};
+constexpr std::string_view kRecorderKeys[] = {"path",  "enabled", "max_file_bytes", "flush_interval",
+                                              "overwrite", "sync", "ring_capacity"};
+
+// A float's allowed range: [lo, hi] with either end open; infinities only when allow_inf.
+struct FloatRange {
+  double lo = -std::numeric_limits<double>::infinity();
+  bool lo_open = false;
+  double hi = std::numeric_limits<double>::infinity();
+  bool hi_open = false;
+  bool allow_inf = false;
+
+  bool contains(double v) const {
+    if (std::isnan(v) || (std::isinf(v) && !allow_inf)) return false;
+    if (lo_open ? !(v > lo) : !(v >= lo)) return false;
+    if (std::isinf(hi)) return true;
+    return hi_open ? v < hi : v <= hi;
+  }
+  std::string describe() const {
+    if (std::isinf(hi)) return std::string(lo_open ? "> " : ">= ") + number(lo);
+    return std::string(lo_open ? "in (" : "in [") + number(lo) + ", " + number(hi) + (hi_open ? ")" : "]");
+  }
+};
+constexpr FloatRange kPositive{0.0, true};
+constexpr FloatRange kNonNegative{0.0, false};
+constexpr FloatRange kUnitInterval{0.0, true, 1.0, false};  // (0, 1]
+
+template <typename E>
+struct Choice {
+  std::string_view text;
+  E value;
+};
+
+// Where a value was given: its position and dotted key.
+struct Where {
+  toml::source_position at{};
+  std::string key;
+};
+
+template <typename T>
+struct Given {
+  T value;
+  Where where;
+};
+
+// One engine table ([engine] or [stream.engine]), type- and range-checked key by key.
+struct EngineLayer {
+  const toml::table* table = nullptr;
+  std::string prefix;
+  std::optional<Given<int>> window, lag, order, iterations;
+  std::optional<Given<WindowSolver>> solver;
+  std::optional<Given<double>> smoothing, smoothing_r, smoothing_t, cutoff_hz, rate_hz, continuity, lambda_r,
+      lambda_t, epsilon_r, epsilon_t, gap, unit_tolerance;
+  std::optional<Given<OperatorVariant>> variant;
+  std::optional<Given<BoundPolicy>> bound;
+};
+
+class Parser {
+ public:
+  Parser(std::string file, std::filesystem::path base) : file_(std::move(file)), base_(std::move(base)) {}
+
+  DaemonConfig parse(const toml::table& root) {
+    DaemonConfig config;
+    check_keys(root, "", kRootKeys);
+    if (const toml::node* n = root.get("daemon")) config.daemon = parse_daemon(table_of(*n, "daemon", "[daemon]"));
+    if (const toml::node* n = root.get("logging")) config.logging = parse_logging(table_of(*n, "logging", "[logging]"));
+    EngineLayer global;
+    global.prefix = "engine";
+    if (const toml::node* n = root.get("engine")) global = parse_engine(table_of(*n, "engine", "[engine]"), "engine");
+
+    const toml::node* streams = root.get("stream");
+    if (streams == nullptr) fail(toml::source_position{}, "stream", "missing required key: at least one [[stream]] table is needed");
+    const toml::array& stream_array = array_of_tables(*streams, "stream", "[[stream]]");
+    if (stream_array.empty()) fail(*streams, "stream", "at least one [[stream]] table is required");
+    for (std::size_t i = 0; i < stream_array.size(); ++i) {
+      config.streams.push_back(parse_stream(stream_array[i], element_key("stream", i), global, config.streams));
+    }
+
+    if (const toml::node* n = root.get("output")) {
+      const toml::array& outputs = array_of_tables(*n, "output", "[[output]]");
+      for (std::size_t i = 0; i < outputs.size(); ++i)
+        config.outputs.push_back(parse_output(outputs[i], element_key("output", i), config.streams));
+    }
+    if (const toml::node* n = root.get("recorder")) config.recorder = parse_recorder(table_of(*n, "recorder", "[recorder]"));
+    return config;
+  }
+
+ private:
+  // --- errors ---
+  [[noreturn]] void fail(const toml::source_position& at, const std::string& key, const std::string& message) const {
+    throw ConfigError(file_, at.line, at.line > 0 ? at.column : 0, key, message);
+  }
+  [[noreturn]] void fail(const toml::node& at, const std::string& key, const std::string& message) const {
+    fail(at.source().begin, key, message);
+  }
+  [[noreturn]] void fail(const Where& where, const std::string& message) const { fail(where.at, where.key, message); }
+  [[noreturn]] void wrong_type(const toml::node& n, const std::string& key, std::string_view expected) const {
+    fail(n, key, "expected " + std::string(expected) + ", got " + std::string(type_name(n.type())));
+  }
+
+  // --- structure ---
+  // Every key of t must be one of `known`; the first unknown one in file order is reported.
+  void check_keys(const toml::table& t, const std::string& prefix, std::span<const std::string_view> known) const {
+    const toml::key* first = nullptr;
+    for (auto&& [k, v] : t) {
+      if (std::find(known.begin(), known.end(), k.str()) != known.end()) continue;
+      if (first == nullptr || before(k.source().begin, first->source().begin)) first = &k;
+    }
+    if (first != nullptr) fail(first->source().begin, join_key(prefix, first->str()), "unknown key" + suggestion(first->str(), known));
+  }
+
+  const toml::node& require(const toml::table& t, std::string_view name, const std::string& prefix) const {
+    const toml::node* n = t.get(name);
+    if (n == nullptr) fail(t.source().begin, join_key(prefix, name), "missing required key");
+    return *n;
+  }
+
+  const toml::table& table_of(const toml::node& n, const std::string& key, std::string_view header) const {
+    if (!n.is_table()) wrong_type(n, key, "a table (" + std::string(header) + ")");
+    return *n.as_table();
+  }
+
+  const toml::array& array_of_tables(const toml::node& n, const std::string& key, std::string_view header) const {
+    if (!n.is_array()) wrong_type(n, key, "an array of tables (" + std::string(header) + ")");
+    return *n.as_array();
+  }
+
+  // --- values ---
+  bool get_bool(const toml::node& n, const std::string& key) const {
+    if (!n.is_boolean()) wrong_type(n, key, "a boolean");
+    return n.as_boolean()->get();
+  }
+
+  std::string get_string(const toml::node& n, const std::string& key) const {
+    if (!n.is_string()) wrong_type(n, key, "a string");
+    return n.as_string()->get();
+  }
+
+  std::string get_nonempty_string(const toml::node& n, const std::string& key) const {
+    std::string s = get_string(n, key);
+    if (s.empty()) fail(n, key, "must not be empty");
+    return s;
+  }
+
+  std::int64_t get_int(const toml::node& n, const std::string& key, std::int64_t lo, std::int64_t hi) const {
+    if (!n.is_integer()) wrong_type(n, key, "an integer");
+    const std::int64_t v = n.as_integer()->get();
+    if (v < lo || v > hi) {
+      const std::string range = hi == kMaxI64 ? ">= " + std::to_string(lo)
+                                              : "in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+      fail(n, key, "out of range: must be " + range + ", got " + std::to_string(v));
+    }
+    return v;
+  }
+
+  std::uint32_t get_u32(const toml::node& n, const std::string& key) const {
+    return static_cast<std::uint32_t>(get_int(n, key, 0, kMaxU32));
+  }
+
+  std::uint32_t get_ring_capacity(const toml::node& n, const std::string& key) const {
+    if (!n.is_integer()) wrong_type(n, key, "an integer");
+    const std::int64_t v = n.as_integer()->get();
+    if (v < 2 || v > kMaxRingCapacity || (v & (v - 1)) != 0)
+      fail(n, key, "must be a power of two in [2, 1048576], got " + std::to_string(v));
+    return static_cast<std::uint32_t>(v);
+  }
+
+  // A float; integers are accepted too (smoothing = 100).
+  double get_float(const toml::node& n, const std::string& key, const FloatRange& range) const {
+    double v = 0.0;
+    if (n.is_floating_point())
+      v = n.as_floating_point()->get();
+    else if (n.is_integer())
+      v = static_cast<double>(n.as_integer()->get());
+    else
+      wrong_type(n, key, "a number");
+    if (!range.contains(v)) fail(n, key, "out of range: must be " + range.describe() + ", got " + number(v));
+    return v;
+  }
+
+  template <typename E>
+  E get_choice(const toml::node& n, const std::string& key, std::initializer_list<Choice<E>> choices) const {
+    const std::string s = get_string(n, key);
+    std::vector<std::string_view> texts;
+    for (const Choice<E>& c : choices) {
+      if (c.text == s) return c.value;
+      texts.push_back(c.text);
+    }
+    std::string list;
+    for (std::string_view t : texts) list += (list.empty() ? "" : ", ") + in_quotes(t);
+    fail(n, key, "expected one of " + list + ", got " + in_quotes(s) + suggestion(s, texts));
+  }
+
+  Where where(const toml::node& n, const std::string& key) const { return Where{n.source().begin, key}; }
+
+  std::filesystem::path resolve(const std::string& text) const {
+    std::filesystem::path p(text);
+    if (p.is_relative()) p = base_ / p;
+    return p.lexically_normal();
+  }
+
+  // --- tables ---
+  DaemonSettings parse_daemon(const toml::table& t) const {
+    const std::string prefix = "daemon";
+    check_keys(t, prefix, kDaemonKeys);
+    DaemonSettings d;
+    if (const toml::node* n = t.get("exit_when_sources_end")) d.exit_when_sources_end = get_bool(*n, join_key(prefix, "exit_when_sources_end"));
+    if (const toml::node* n = t.get("session_id")) d.session_id = get_u32(*n, join_key(prefix, "session_id"));
+    return d;
+  }
+
+  LoggingConfig parse_logging(const toml::table& t) const {
+    const std::string prefix = "logging";
+    check_keys(t, prefix, kLoggingKeys);
+    LoggingConfig l;
+    if (const toml::node* n = t.get("level")) {
+      l.level = get_choice<std::string_view>(*n, join_key(prefix, "level"),
+                                             {{"trace", "trace"}, {"debug", "debug"}, {"info", "info"}, {"warn", "warn"},
+                                              {"error", "error"}, {"critical", "critical"}, {"off", "off"}});
+    }
+    if (const toml::node* n = t.get("target")) {
+      l.target = get_choice<LogTarget>(*n, join_key(prefix, "target"),
+                                       {{"auto", LogTarget::Auto}, {"stderr", LogTarget::Stderr}, {"journald", LogTarget::Journald}});
+    }
+    if (const toml::node* n = t.get("status_interval")) l.status_interval = get_float(*n, join_key(prefix, "status_interval"), kNonNegative);
+    return l;
+  }
+
+  EngineLayer parse_engine(const toml::table& t, const std::string& prefix) const {
+    check_keys(t, prefix, kEngineKeys);
+    EngineLayer e;
+    e.table = &t;
+    e.prefix = prefix;
+    auto integer = [&](std::string_view name, std::optional<Given<int>>& out, std::int64_t lo, std::int64_t hi) {
+      if (const toml::node* n = t.get(name)) {
+        const std::string key = join_key(prefix, name);
+        out = Given<int>{static_cast<int>(get_int(*n, key, lo, hi)), where(*n, key)};
+      }
+    };
+    auto real = [&](std::string_view name, std::optional<Given<double>>& out, const FloatRange& range) {
+      if (const toml::node* n = t.get(name)) {
+        const std::string key = join_key(prefix, name);
+        out = Given<double>{get_float(*n, key, range), where(*n, key)};
+      }
+    };
+    auto choice = [&](std::string_view name, auto& out, auto choices) {
+      if (const toml::node* n = t.get(name)) {
+        const std::string key = join_key(prefix, name);
+        using E = decltype(out->value);
+        out = Given<E>{get_choice<E>(*n, key, choices), where(*n, key)};
+      }
+    };
+    integer("window", e.window, 2, 4096);
+    integer("lag", e.lag, 0, 4095);
+    if (const toml::node* n = t.get("order")) {
+      const std::string key = join_key(prefix, "order");
+      if (!n->is_integer()) wrong_type(*n, key, "an integer");
+      const std::int64_t v = n->as_integer()->get();
+      if (v != 2 && v != 3) fail(*n, key, "must be 2 or 3, got " + std::to_string(v));
+      e.order = Given<int>{static_cast<int>(v), where(*n, key)};
+    }
+    choice("solver", e.solver,
+           std::initializer_list<Choice<WindowSolver>>{{"linear", WindowSolver::Linear},
+                                                       {"gauss-newton", WindowSolver::GaussNewton},
+                                                       {"sweeps", WindowSolver::DampedSweeps}});
+    integer("iterations", e.iterations, 1, 1000);
+    const FloatRange smoothing_range{0.0, true, kMaxSmoothing, false};
+    real("smoothing", e.smoothing, smoothing_range);
+    real("smoothing_r", e.smoothing_r, smoothing_range);
+    real("smoothing_t", e.smoothing_t, smoothing_range);
+    real("cutoff_hz", e.cutoff_hz, kPositive);
+    real("rate_hz", e.rate_hz, kPositive);
+    real("continuity", e.continuity, kNonNegative);
+    real("lambda_r", e.lambda_r, kUnitInterval);
+    real("lambda_t", e.lambda_t, kUnitInterval);
+    choice("variant", e.variant,
+           std::initializer_list<Choice<OperatorVariant>>{{"corrected", OperatorVariant::Corrected},
+                                                          {"printed", OperatorVariant::Printed}});
+    FloatRange epsilon_range = kPositive;
+    epsilon_range.allow_inf = true;  // inf: no bound (the default)
+    real("epsilon_r", e.epsilon_r, epsilon_range);
+    real("epsilon_t", e.epsilon_t, epsilon_range);
+    choice("bound", e.bound,
+           std::initializer_list<Choice<BoundPolicy>>{{"sample", BoundPolicy::Sample}, {"window", BoundPolicy::Window}});
+    real("gap", e.gap, kPositive);
+    real("unit_tolerance", e.unit_tolerance, FloatRange{0.0, true, 1.0, true});
+
+    if (e.cutoff_hz) {
+      for (const auto* other : {&e.smoothing, &e.smoothing_r, &e.smoothing_t}) {
+        if (*other) {
+          fail(e.cutoff_hz->where, "cannot be given together with " + (*other)->where.key + " (line " +
+                                       std::to_string((*other)->where.at.line) +
+                                       ") in one table: cutoff_hz sets smoothing_r and smoothing_t");
+        }
+      }
+    }
+    return e;
+  }
+
+  // [engine] with the stream's [stream.engine] on top, applied to WindowConfig's defaults,
+  // then validated as the engine would.
+  WindowConfig build_engine(const EngineLayer& global, const EngineLayer* local,
+                            const std::optional<Given<double>>& driver_rate, const toml::table& stream_table,
+                            const std::string& stream_prefix, const std::string& stream_name) const {
+    WindowConfig c;
+    std::map<std::string, Where, std::less<>> origin;  // WindowConfig field -> where it was set
+    struct Smoothing {
+      bool set = false;
+      bool from_cutoff = false;
+      double value = 0.0;  // μ, or the cutoff in Hz
+      Where where;
+    };
+    Smoothing r, t;
+    for (const EngineLayer* layer : {&global, local}) {
+      if (layer == nullptr) continue;
+      auto take = [&](const auto& given, auto& field, const char* name) {
+        if (given) {
+          field = given->value;
+          origin[name] = given->where;
+        }
+      };
+      take(layer->window, c.window, "window");
+      take(layer->lag, c.lag, "lag");
+      take(layer->order, c.order, "order");
+      take(layer->solver, c.solver, "solver");
+      take(layer->iterations, c.iterations, "iterations");
+      take(layer->continuity, c.continuity, "continuity");
+      take(layer->lambda_r, c.lambda_r, "lambda_r");
+      take(layer->lambda_t, c.lambda_t, "lambda_t");
+      take(layer->variant, c.variant, "variant");
+      take(layer->epsilon_t, c.epsilon_t, "epsilon_t");
+      take(layer->bound, c.bound, "bound");
+      take(layer->gap, c.gate.gap_threshold, "gap_threshold");
+      take(layer->unit_tolerance, c.gate.unit_tolerance, "unit_tolerance");
+      if (layer->epsilon_r) {
+        // Given as a rotation angle; the engine's bound is the distance on S³, half of it.
+        c.epsilon_r = layer->epsilon_r->value / 2.0;
+        origin["epsilon_r"] = layer->epsilon_r->where;
+      }
+      // A more specific table replaces what a less specific one said, key by key; cutoff_hz
+      // counts as `smoothing` given as a frequency.
+      if (layer->cutoff_hz) r = t = Smoothing{true, true, layer->cutoff_hz->value, layer->cutoff_hz->where};
+      if (layer->smoothing) r = t = Smoothing{true, false, layer->smoothing->value, layer->smoothing->where};
+      if (layer->smoothing_r) r = Smoothing{true, false, layer->smoothing_r->value, layer->smoothing_r->where};
+      if (layer->smoothing_t) t = Smoothing{true, false, layer->smoothing_t->value, layer->smoothing_t->where};
+    }
+
+    // The stream's sample rate: its own [stream.engine], else a synthetic driver's rate, else [engine].
+    std::optional<Given<double>> rate;
+    if (local != nullptr && local->rate_hz)
+      rate = local->rate_hz;
+    else if (driver_rate)
+      rate = driver_rate;
+    else if (global.rate_hz)
+      rate = global.rate_hz;
+
+    auto resolve_smoothing = [&](const Smoothing& s, double& field, const char* name) {
+      if (!s.set) return;
+      origin[name] = s.where;
+      if (!s.from_cutoff) {
+        field = s.value;
+        return;
+      }
+      if (!rate)
+        fail(s.where, "needs rate_hz, the stream's sample rate in Hz (in [engine] or [stream.engine])" +
+                          std::string(s.where.key.starts_with(stream_prefix) ? "" : " for " + stream_prefix + " " + in_quotes(stream_name)));
+      try {
+        field = smoothing_for_cutoff(s.value, rate->value, c.order);
+      } catch (const std::invalid_argument&) {
+        fail(s.where, "must be below half the sample rate: cutoff_hz " + number(s.value) + " Hz, rate_hz " +
+                          number(rate->value) + " Hz (" + rate->where.key + ")");
+      }
+    };
+    resolve_smoothing(r, c.smoothing_r, "smoothing_r");
+    resolve_smoothing(t, c.smoothing_t, "smoothing_t");
+
+    try {
+      validate(c);
+      // The constructor also refuses an unstable continuity (and checks the gate). It
+      // factorises the system for every fill level: milliseconds up to W = 512, which covers
+      // every continuity > 0 (validate allows no more), but seconds and hundreds of MB at
+      // W = 4096, which the daemon pays once at start, not again for --check or a reload.
+      if (c.window <= 512 || c.continuity > 0.0) {
+        const FairingWindow probe(c);
+      } else {
+        const SampleGate gate(c.gate);
+      }
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      std::string field = what.substr(0, what.find(' '));
+      if (what.starts_with("the window bound policy")) field = "bound";
+      Where at;
+      if (auto it = origin.find(field); it != origin.end()) {
+        at = it->second;
+      } else if (local != nullptr) {
+        at = Where{local->table->source().begin, local->prefix};
+      } else if (global.table != nullptr) {
+        at = Where{global.table->source().begin, global.prefix};
+      } else {
+        at = Where{stream_table.source().begin, stream_prefix};
+      }
+      std::string message = what;
+      const Smoothing* s = field == "smoothing_r" ? &r : field == "smoothing_t" ? &t : nullptr;
+      if (s != nullptr && s->from_cutoff)
+        message = "cutoff_hz " + number(s->value) + " Hz at rate_hz " + number(rate->value) + " Hz gives " + what;
+      if (!at.key.starts_with(stream_prefix)) message += " (for " + stream_prefix + " " + in_quotes(stream_name) + ")";
+      fail(at, message);
+    }
+    return c;
+  }
+
+  // [stream.driver]; returns a synthetic driver's rate (the engine's default rate_hz).
+  std::optional<Given<double>> parse_driver(const toml::table& t, const std::string& prefix, StreamConfig& s) const {
+    const std::string type_key = join_key(prefix, "type");
+    const toml::node& type_node = require(t, "type", prefix);
+    s.driver.type = get_choice<DriverType>(type_node, type_key, {{"replay", DriverType::Replay}, {"synthetic", DriverType::Synthetic}});
+    const bool replay = s.driver.type == DriverType::Replay;
+    const std::span<const std::string_view> own = replay ? std::span<const std::string_view>(kReplayKeys) : std::span<const std::string_view>(kSyntheticKeys);
+    const std::span<const std::string_view> other = replay ? std::span<const std::string_view>(kSyntheticKeys) : std::span<const std::string_view>(kReplayKeys);
+    const char* own_name = replay ? "replay" : "synthetic";
+    const char* other_name = replay ? "synthetic" : "replay";
+    const toml::key* first = nullptr;
+    for (auto&& [k, v] : t) {
+      if (std::find(own.begin(), own.end(), k.str()) != own.end()) continue;
+      if (first == nullptr || before(k.source().begin, first->source().begin)) first = &k;
+    }
+    if (first != nullptr) {
+      const std::string key = join_key(prefix, first->str());
+      if (std::find(other.begin(), other.end(), first->str()) != other.end())
+        fail(first->source().begin, key, std::string("unknown key for driver type ") + own_name + " (it belongs to type " + other_name + ")");
+      fail(first->source().begin, key, std::string("unknown key for driver type ") + own_name + suggestion(first->str(), own));
+    }
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+
+    if (replay) {
+      ReplaySourceConfig& r = s.driver.replay;
+      const toml::node& path_node = require(t, "path", prefix);
+      r.path = resolve(get_nonempty_string(path_node, key("path")));
+      std::error_code ec;
+      const auto status = std::filesystem::status(r.path, ec);
+      if (!std::filesystem::exists(status)) fail(path_node, key("path"), "no such file: " + r.path.string());
+      if (!std::filesystem::is_regular_file(status)) fail(path_node, key("path"), "not a regular file: " + r.path.string());
+      drivers::ReplayOptions& o = r.options;
+      o.stream_id = s.id;
+      if (const toml::node* n = t.get("timing"))
+        o.timing = get_choice<drivers::ReplayTiming>(*n, key("timing"), {{"original", drivers::ReplayTiming::Original},
+                                                                         {"fast", drivers::ReplayTiming::AsFastAsPossible}});
+      if (const toml::node* n = t.get("speed")) o.speed = get_float(*n, key("speed"), kPositive);
+      if (const toml::node* n = t.get("schedule"))
+        o.schedule = get_choice<drivers::ReplaySchedule>(*n, key("schedule"), {{"time", drivers::ReplaySchedule::Time},
+                                                                               {"receive-time", drivers::ReplaySchedule::ReceiveTime}});
+      if (const toml::node* n = t.get("loop")) o.loop = get_bool(*n, key("loop"));
+      if (const toml::node* n = t.get("rounds")) o.max_rounds = static_cast<std::uint64_t>(get_int(*n, key("rounds"), 0, kMaxI64));
+      if (const toml::node* n = t.get("format")) {
+        o.pose.format = get_choice<std::optional<drivers::PoseFormat>>(
+            *n, key("format"),
+            {{"auto", std::nullopt}, {"tum", drivers::PoseFormat::Tum}, {"csv", drivers::PoseFormat::Csv}, {"bvh", drivers::PoseFormat::Bvh}});
+      }
+      if (const toml::node* n = t.get("joint")) o.pose.bvh_joint = get_nonempty_string(*n, key("joint"));
+      if (const toml::node* n = t.get("csv_prefix")) o.pose.csv_prefix = get_string(*n, key("csv_prefix"));
+      if (const toml::node* n = t.get("skip_missing")) o.pose.skip_missing = get_bool(*n, key("skip_missing"));
+      if (const toml::node* n = t.get("source_stream")) r.source_stream = get_u32(*n, key("source_stream"));
+      const auto format = o.pose.format ? o.pose.format : drivers::format_from_extension(r.path);
+      if (format == drivers::PoseFormat::Bvh && o.pose.bvh_joint.empty())
+        fail(t.source().begin, key("joint"), "missing required key (a BVH source plays one joint)");
+      return std::nullopt;
+    }
+
+    SyntheticSourceConfig& g = s.driver.synthetic;
+    std::optional<Given<double>> rate;
+    if (const toml::node* n = t.get("rate_hz")) {
+      g.rate_hz = get_float(*n, key("rate_hz"), FloatRange{0.0, true, 100000.0, false});
+      rate = Given<double>{g.rate_hz, where(*n, key("rate_hz"))};
+    } else {
+      rate = Given<double>{g.rate_hz, Where{t.source().begin, prefix}};
+    }
+    if (const toml::node* n = t.get("duration")) g.duration = get_float(*n, key("duration"), kNonNegative);
+    if (const toml::node* n = t.get("rotation_noise")) g.rotation_noise = get_float(*n, key("rotation_noise"), kNonNegative);
+    if (const toml::node* n = t.get("with_position")) g.with_position = get_bool(*n, key("with_position"));
+    if (const toml::node* n = t.get("seed")) g.seed = static_cast<std::uint64_t>(get_int(*n, key("seed"), 0, kMaxI64));
+    return rate;
+  }
+
+  StreamConfig parse_stream(const toml::node& node, const std::string& prefix, const EngineLayer& global,
+                            const std::vector<StreamConfig>& earlier) const {
+    const toml::table& t = table_of(node, prefix, "[[stream]]");
+    check_keys(t, prefix, kStreamKeys);
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    StreamConfig s;
+    const toml::node& id_node = require(t, "id", prefix);
+    s.id = get_u32(id_node, key("id"));
+    const toml::node& name_node = require(t, "name", prefix);
+    s.name = get_nonempty_string(name_node, key("name"));
+    for (std::size_t i = 0; i < earlier.size(); ++i) {
+      if (earlier[i].id == s.id)
+        fail(id_node, key("id"), "duplicate stream id " + std::to_string(s.id) + " (also " + element_key("stream", i) + ")");
+      if (earlier[i].name == s.name)
+        fail(name_node, key("name"), "duplicate stream name " + in_quotes(s.name) + " (also " + element_key("stream", i) + ")");
+    }
+    if (const toml::node* n = t.get("ring_capacity")) s.ring_capacity = get_ring_capacity(*n, key("ring_capacity"));
+    if (const toml::node* n = t.get("overflow"))
+      s.overflow = get_choice<OverflowPolicy>(*n, key("overflow"), {{"drop-oldest", OverflowPolicy::DropOldest},
+                                                                    {"drop-newest", OverflowPolicy::DropNewest}});
+    const toml::node& driver_node = require(t, "driver", prefix);
+    const std::optional<Given<double>> driver_rate =
+        parse_driver(table_of(driver_node, key("driver"), "[stream.driver]"), key("driver"), s);
+    std::optional<EngineLayer> local;
+    if (const toml::node* n = t.get("engine")) local = parse_engine(table_of(*n, key("engine"), "[stream.engine]"), key("engine"));
+    s.engine = build_engine(global, local ? &*local : nullptr, driver_rate, t, prefix, s.name);
+    return s;
+  }
+
+  OutputConfig parse_output(const toml::node& node, const std::string& prefix, const std::vector<StreamConfig>& streams) const {
+    const toml::table& t = table_of(node, prefix, "[[output]]");
+    check_keys(t, prefix, kOutputKeys);
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    OutputConfig o;
+    if (const toml::node* n = t.get("encoding"))
+      o.encoding = get_choice<WireEncoding>(*n, key("encoding"), {{"binary", WireEncoding::kBinary}, {"json", WireEncoding::kJson}});
+
+    const toml::node& dest_node = require(t, "destinations", prefix);
+    if (!dest_node.is_array()) wrong_type(dest_node, key("destinations"), "an array of strings");
+    const toml::array& dests = *dest_node.as_array();
+    if (dests.empty()) fail(dest_node, key("destinations"), "must list at least one destination");
+    for (std::size_t i = 0; i < dests.size(); ++i) {
+      const std::string k = element_key(key("destinations"), i);
+      const std::string text = get_string(dests[i], k);
+      const std::optional<Endpoint> e = Endpoint::parse(text, kDefaultPort);
+      if (!e)
+        fail(dests[i], k, "not a destination: " + in_quotes(text) +
+                              "; expected a numeric IPv4 or IPv6 address with an optional port, e.g. '239.255.0.1:5700' or '[::1]:5700'");
+      if (e->port() == 0) fail(dests[i], k, "port 0 is not a destination: " + in_quotes(text));
+      if (e->is_unspecified()) fail(dests[i], k, "the unspecified address is not a destination: " + in_quotes(text));
+      o.destinations.push_back(*e);
+    }
+
+    if (const toml::node* n = t.get("ttl")) o.send.multicast_ttl = static_cast<int>(get_int(*n, key("ttl"), 0, 255));
+    if (const toml::node* n = t.get("interface")) o.send.interface.name_or_address = get_nonempty_string(*n, key("interface"));
+    if (const toml::node* n = t.get("loopback")) o.send.multicast_loopback = get_bool(*n, key("loopback"));
+    if (const toml::node* n = t.get("angular_velocity")) o.angular_velocity = get_bool(*n, key("angular_velocity"));
+    if (const toml::node* n = t.get("streams")) {
+      if (!n->is_array()) wrong_type(*n, key("streams"), "an array of stream ids");
+      const toml::array& ids = *n->as_array();
+      for (std::size_t i = 0; i < ids.size(); ++i) {
+        const std::string k = element_key(key("streams"), i);
+        const std::uint32_t id = get_u32(ids[i], k);
+        if (std::none_of(streams.begin(), streams.end(), [&](const StreamConfig& s) { return s.id == id; }))
+          fail(ids[i], k, "no [[stream]] has id " + std::to_string(id));
+        if (std::find(o.streams.begin(), o.streams.end(), id) != o.streams.end())
+          fail(ids[i], k, "stream " + std::to_string(id) + " is listed twice");
+        o.streams.push_back(id);
+      }
+    }
+    return o;
+  }
+
+  RecorderConfig parse_recorder(const toml::table& t) const {
+    const std::string prefix = "recorder";
+    check_keys(t, prefix, kRecorderKeys);
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    RecorderConfig r;
+    r.enabled = true;
+    if (const toml::node* n = t.get("enabled")) r.enabled = get_bool(*n, key("enabled"));
+    const toml::node& path_node = require(t, "path", prefix);
+    r.path = resolve(get_nonempty_string(path_node, key("path")));
+    if (const toml::node* n = t.get("max_file_bytes")) r.max_file_bytes = static_cast<std::uint64_t>(get_int(*n, key("max_file_bytes"), 0, kMaxI64));
+    if (const toml::node* n = t.get("flush_interval")) r.flush_interval = get_float(*n, key("flush_interval"), kPositive);
+    if (const toml::node* n = t.get("overwrite")) r.overwrite = get_bool(*n, key("overwrite"));
+    if (const toml::node* n = t.get("sync")) r.sync = get_bool(*n, key("sync"));
+    if (const toml::node* n = t.get("ring_capacity")) r.ring_capacity = get_ring_capacity(*n, key("ring_capacity"));
+    if (r.enabled) {
+      std::error_code ec;
+      if (std::filesystem::is_directory(r.path, ec)) fail(path_node, key("path"), "is a directory: " + r.path.string());
+      const std::filesystem::path dir = r.path.parent_path();
+      if (!std::filesystem::is_directory(dir, ec)) fail(path_node, key("path"), "no such directory: " + dir.string());
+    }
+    return r;
+  }
+
+  std::string file_;
+  std::filesystem::path base_;
+};
+
+}  // namespace
+
+DaemonConfig parse_config(std::string_view text, const std::filesystem::path& file) {
+  const std::string name = file.string();
+  try {
+    toml::table root;
+    try {
+      root = toml::parse(text, std::string_view(name));
+    } catch (const toml::parse_error& e) {
+      const toml::source_position at = e.source().begin;
+      throw ConfigError(name, at.line, at.line > 0 ? at.column : 0, "", std::string(e.description()));
+    }
+    std::error_code ec;
+    std::filesystem::path absolute = std::filesystem::absolute(file, ec);
+    if (ec) absolute = file;
+    Parser parser(name, absolute.parent_path());
+    DaemonConfig config = parser.parse(root);
+    config.source_file = file;
+    return config;
+  } catch (const ConfigError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw ConfigError(name, 0, 0, "", e.what());  // e.g. out of memory: still a ConfigError
+  }
+}
+
+DaemonConfig load_config(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(name.c_str(), "rb"), &std::fclose);
+  if (!f) throw ConfigError(name, 0, 0, "", std::string("cannot read: ") + std::strerror(errno));
+  std::string text;
+  char buf[65536];
+  std::size_t got = 0;
+  while ((got = std::fread(buf, 1, sizeof buf, f.get())) > 0) text.append(buf, got);
+  if (std::ferror(f.get())) throw ConfigError(name, 0, 0, "", std::string("cannot read: ") + std::strerror(errno));
+  return parse_config(text, file);
+}
+
+}  // namespace posefair::daemon

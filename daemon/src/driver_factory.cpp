@@ -1,0 +1,85 @@
+#include "posefair/daemon/driver_factory.hpp"
+
+#include <stdexcept>
+#include <utility>
+
+#include "posefair/drivers/replay_driver.hpp"
+#include "posefair/drivers/synthetic_driver.hpp"
+
+namespace posefair::daemon {
+namespace {
+
+MadeDriver make_replay(const StreamConfig& stream) {
+  const ReplaySourceConfig& rc = stream.driver.replay;
+  drivers::ReplayOptions options = rc.options;
+  options.stream_id = stream.id;
+  const std::string where = "stream '" + stream.name + "': replay " + rc.path.string() + ": ";
+  MadeDriver made;
+  made.source = "replay:" + rc.path.string();
+  try {
+    drivers::ReplayDriver loaded(rc.path, options);
+    made.warnings = loaded.warnings();
+    // A sample log can hold several streams: keep the one asked for and give it this id.
+    std::vector<std::uint32_t> ids;
+    for (const drivers::StreamInfo& info : loaded.streams()) ids.push_back(info.id);
+    std::uint32_t wanted = stream.id;
+    if (rc.source_stream) {
+      wanted = *rc.source_stream;
+    } else if (ids.size() == 1) {
+      wanted = ids[0];
+    } else {
+      throw std::runtime_error(where + "the log holds " + std::to_string(ids.size()) +
+                               " streams; choose one with source_stream");
+    }
+    std::vector<Sample> samples;
+    samples.reserve(loaded.samples().size());
+    for (Sample s : loaded.samples()) {
+      if (s.stream_id != wanted) continue;
+      s.stream_id = stream.id;
+      samples.push_back(s);
+    }
+    if (samples.empty()) throw std::runtime_error(where + "no samples of stream " + std::to_string(wanted));
+    if (rc.source_stream) made.source += " stream " + std::to_string(wanted);
+    made.driver = std::make_unique<drivers::ReplayDriver>(std::move(samples), options, made.source);
+  } catch (const drivers::SampleLogError& e) {
+    throw std::runtime_error(where + e.what());
+  } catch (const drivers::PoseFileError& e) {
+    throw std::runtime_error(where + e.what());
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(where + e.what());
+  }
+  return made;
+}
+
+MadeDriver make_synthetic(const StreamConfig& stream) {
+  const SyntheticSourceConfig& sc = stream.driver.synthetic;
+  drivers::SyntheticOptions o;
+  o.rate_hz = sc.rate_hz;
+  o.duration = sc.duration;
+  o.rotation_noise = sc.rotation_noise;
+  o.with_position = sc.with_position;
+  o.seed = sc.seed;
+  o.stream_id = stream.id;
+  MadeDriver made;
+  try {
+    made.driver = std::make_unique<drivers::SyntheticDriver>(o);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("stream '" + stream.name + "': " + e.what());
+  }
+  made.source = std::string(made.driver->name());
+  return made;
+}
+
+}  // namespace
+
+MadeDriver make_driver(const StreamConfig& stream) {
+  switch (stream.driver.type) {
+    case DriverType::Replay:
+      return make_replay(stream);
+    case DriverType::Synthetic:
+      return make_synthetic(stream);
+  }
+  throw std::logic_error("make_driver: unknown driver type");
+}
+
+}  // namespace posefair::daemon

@@ -1,0 +1,301 @@
+#include "posefair/daemon/pipeline.hpp"
+
+#include <chrono>
+#include <ctime>
+#include <filesystem>
+#include <stdexcept>
+#include <utility>
+
+#include "posefair/core/fairing_window.hpp"
+#include "posefair/daemon/driver_factory.hpp"
+#include "posefair/daemon/publisher.hpp"
+#include "posefair/daemon/ring_items.hpp"
+#include "posefair/daemon/spsc_ring.hpp"
+
+namespace posefair::daemon {
+
+namespace {
+
+std::filesystem::path expand_time_pattern(const std::filesystem::path& path) {
+  const std::string name = path.filename().string();
+  if (name.find('%') == std::string::npos) return path;
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  ::localtime_r(&now, &local);
+  char buf[512];
+  const std::size_t n = std::strftime(buf, sizeof buf, name.c_str(), &local);
+  if (n == 0) throw std::runtime_error("recorder: cannot expand the time pattern in " + path.string());
+  return path.parent_path() / std::string(buf, n);
+}
+
+}  // namespace
+
+// Drained per ring per pass, so one busy stream cannot starve the others.
+constexpr int kPopBudget = 64;
+
+struct Pipeline::Stream final : drivers::SampleSink {
+  Stream(Pipeline& owner, const StreamConfig& c, MadeDriver made, std::uint32_t index, bool record)
+      : pipeline(owner),
+        config(c),
+        index(index),
+        driver(std::move(made.driver)),
+        source(std::move(made.source)),
+        window(c.engine),
+        ring(c.ring_capacity, c.overflow),
+        // The publisher ring drops the oldest pose: a subscriber wants the newest.
+        pose_ring(c.ring_capacity, OverflowPolicy::DropOldest),
+        outputs(static_cast<std::size_t>(window.max_outputs_per_push())) {
+    if (record) record_ring = std::make_unique<SpscRing<RingSample>>(owner.config_.recorder.ring_capacity, OverflowPolicy::DropNewest);
+  }
+
+  // Driver thread: hand the sample over (stamped), to the recorder too.
+  bool push(const Sample& s) override {
+    RingSample r = pack(s, monotonic_ns());
+    r.stream_id = config.id;
+    counters.received.fetch_add(1, std::memory_order_relaxed);
+    if (record_ring) record_ring->push(r);
+    const bool stored = ring.push(r);
+    pipeline.wake_engine();
+    return stored;
+  }
+
+  Pipeline& pipeline;
+  StreamConfig config;
+  std::uint32_t index;
+  std::unique_ptr<drivers::Driver> driver;
+  std::string source;
+  FairingWindow window;                         // engine thread only
+  SpscRing<RingSample> ring;                    // driver → engine
+  SpscRing<RingPose> pose_ring;                 // engine → publisher
+  std::unique_ptr<SpscRing<RingSample>> record_ring;  // driver → recorder
+  std::vector<FairedPose> outputs;              // engine scratch
+  StreamCounters counters;
+  std::atomic<bool> driver_running{false};
+  std::atomic<bool> driver_done{false};
+  bool flushed = false;                         // engine thread only
+};
+
+Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
+                   const std::map<std::uint32_t, std::uint64_t>& first_sequence, bool defer_recorder, PipelineHooks hooks)
+    : config_(config), hooks_(std::move(hooks)) {
+  const bool record = config_.recorder.enabled;
+  std::vector<std::uint32_t> ids;
+  for (std::size_t i = 0; i < config_.streams.size(); ++i) {
+    const StreamConfig& sc = config_.streams[i];
+    MadeDriver made = make_driver(sc);
+    for (std::string& w : made.warnings) warnings_.push_back("stream '" + sc.name + "': " + w);
+    header_.streams.push_back(drivers::StreamInfo{sc.id, sc.name, made.source});
+    streams_.push_back(std::make_unique<Stream>(*this, sc, std::move(made), static_cast<std::uint32_t>(i), record));
+    ids.push_back(sc.id);
+  }
+  publisher_ = std::make_unique<Publisher>(session, ids, config_.outputs, first_sequence);
+  if (record && !defer_recorder) {
+    drivers::SampleLogWriterOptions wo;
+    wo.max_file_bytes = config_.recorder.max_file_bytes;
+    wo.flush_interval = config_.recorder.flush_interval;
+    wo.overwrite = config_.recorder.overwrite;
+    wo.sync = config_.recorder.sync;
+    try {
+      writer_ = std::make_unique<drivers::SampleLogWriter>(expand_time_pattern(config_.recorder.path), header_, wo);
+    } catch (const drivers::SampleLogError& e) {
+      throw std::runtime_error(std::string("recorder: ") + e.what());
+    }
+  }
+}
+
+Pipeline::~Pipeline() { stop(); }
+
+void Pipeline::wake_engine() {
+  engine_wake_.fetch_add(1, std::memory_order_release);
+  engine_wake_.notify_one();
+}
+
+void Pipeline::wake_publisher() {
+  publisher_wake_.fetch_add(1, std::memory_order_release);
+  publisher_wake_.notify_one();
+}
+
+void Pipeline::poke_engine() { wake_engine(); }
+
+void Pipeline::start() {
+  if (started_) return;
+  started_ = true;
+  engine_thread_ = std::thread([this] { engine_loop(); });
+  publisher_thread_ = std::thread([this] { publisher_loop(); });
+  if (config_.recorder.enabled) recorder_thread_ = std::thread([this] { recorder_loop(); });
+  drivers_running_.store(static_cast<int>(streams_.size()), std::memory_order_release);
+  for (auto& sp : streams_) {
+    Stream* s = sp.get();
+    s->driver_running.store(true, std::memory_order_release);
+    driver_threads_.emplace_back([this, s](std::stop_token stop) {
+      s->driver->run(stop, *s);
+      s->driver_running.store(false, std::memory_order_release);
+      s->driver_done.store(true, std::memory_order_release);
+      drivers_running_.fetch_sub(1, std::memory_order_acq_rel);
+      wake_engine();
+    });
+  }
+}
+
+bool Pipeline::sources_ended() const { return started_ && drivers_running_.load(std::memory_order_acquire) == 0; }
+
+void Pipeline::stop(bool keep_recorder) {
+  if (!started_ || stopped_) {
+    if (!started_ && !stopped_ && !keep_recorder && writer_) writer_->close();
+    stopped_ = true;
+    if (publisher_) final_sequences_ = publisher_->next_sequences();
+    return;
+  }
+  stopped_ = true;
+  for (auto& t : driver_threads_) t.request_stop();
+  for (auto& t : driver_threads_) t.join();
+  // Drivers are done: the engine drains their rings and flushes the windows, then ends.
+  engine_stop_.store(true, std::memory_order_release);
+  wake_engine();
+  engine_thread_.join();
+  publisher_stop_.store(true, std::memory_order_release);
+  wake_publisher();
+  publisher_thread_.join();
+  if (recorder_thread_.joinable()) {
+    recorder_stop_.store(true, std::memory_order_release);
+    recorder_thread_.join();
+  }
+  if (writer_ && !keep_recorder) writer_->close();
+  final_sequences_ = publisher_->next_sequences();
+}
+
+void Pipeline::engine_loop() {
+  for (;;) {
+    const std::uint32_t seen = engine_wake_.load(std::memory_order_acquire);
+    heartbeat_.fetch_add(1, std::memory_order_relaxed);
+    bool any = false;
+    for (auto& sp : streams_) {
+      Stream& s = *sp;
+      RingSample r;
+      for (int budget = kPopBudget; budget > 0 && s.ring.pop(r); --budget) {
+        any = true;
+        if (hooks_.before_engine_sample) hooks_.before_engine_sample(s.config.id);
+        const int k = s.window.push(unpack(r), s.outputs);
+        for (int j = 0; j < k; ++j) s.pose_ring.push(pack(s.outputs[static_cast<std::size_t>(j)], s.index, r.enqueued_ns));
+      }
+      // The driver has ended and everything it delivered is in: hand over the lagged tail.
+      if (!s.flushed && s.driver_done.load(std::memory_order_acquire) && s.ring.size_approx() == 0) {
+        const int k = s.window.flush(s.outputs);
+        const std::uint64_t now = monotonic_ns();
+        for (int j = 0; j < k; ++j) s.pose_ring.push(pack(s.outputs[static_cast<std::size_t>(j)], s.index, now));
+        s.flushed = true;
+        any = true;
+      }
+      const GateCounters& g = s.window.gate_counters();
+      const WindowCounters& w = s.window.counters();
+      s.counters.rejected.store(g.rejected(), std::memory_order_relaxed);
+      s.counters.out_of_order.store(g.dropped(), std::memory_order_relaxed);
+      s.counters.emitted.store(w.emitted, std::memory_order_relaxed);
+      s.counters.clamped.store(w.clamped, std::memory_order_relaxed);
+      s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
+    }
+    if (any) {
+      wake_publisher();
+      continue;
+    }
+    if (engine_stop_.load(std::memory_order_acquire)) return;
+    engine_wake_.wait(seen, std::memory_order_acquire);
+  }
+}
+
+void Pipeline::publisher_loop() {
+  for (;;) {
+    const std::uint32_t seen = publisher_wake_.load(std::memory_order_acquire);
+    bool any = false;
+    for (auto& sp : streams_) {
+      Stream& s = *sp;
+      RingPose p;
+      for (int budget = kPopBudget; budget > 0 && s.pose_ring.pop(p); --budget) {
+        any = true;
+        const Publisher::Result res = publisher_->publish(p);
+        const std::uint64_t done = monotonic_ns();
+        s.counters.published.fetch_add(1, std::memory_order_relaxed);
+        if (res.failures) s.counters.send_failures.fetch_add(res.failures, std::memory_order_relaxed);
+        s.counters.latency.record(done - p.enqueued_ns);
+      }
+    }
+    if (any) continue;
+    if (publisher_stop_.load(std::memory_order_acquire)) return;
+    publisher_wake_.wait(seen, std::memory_order_acquire);
+  }
+}
+
+void Pipeline::recorder_loop() {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  for (;;) {
+    // Read the flag first: once it is set every driver has returned, so one more full pass
+    // after seeing it takes everything.
+    const bool stopping = recorder_stop_.load(std::memory_order_acquire);
+    for (auto& sp : streams_) {
+      Stream& s = *sp;
+      RingSample r;
+      while (s.record_ring->pop(r)) {
+        if (writer_) writer_->append(unpack(r));
+        s.counters.recorded.fetch_add(1, std::memory_order_relaxed);
+      }
+    }
+    if (writer_) writer_->maybe_flush(std::chrono::duration<double>(clock::now() - t0).count());
+    if (stopping) {
+      if (writer_) writer_->flush();
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
+std::vector<StreamStats> Pipeline::stats() const {
+  std::vector<StreamStats> out;
+  for (const auto& sp : streams_) {
+    const Stream& s = *sp;
+    StreamStats st;
+    st.id = s.config.id;
+    st.name = s.config.name;
+    st.driver = s.source;
+    st.driver_running = s.driver_running.load(std::memory_order_relaxed);
+    const auto get = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
+    st.received = get(s.counters.received);
+    st.ring_dropped = s.ring.dropped();
+    st.rejected = get(s.counters.rejected);
+    st.out_of_order = get(s.counters.out_of_order);
+    st.emitted = get(s.counters.emitted);
+    st.clamped = get(s.counters.clamped);
+    st.restarts = get(s.counters.restarts);
+    st.publish_dropped = s.pose_ring.dropped();
+    st.published = get(s.counters.published);
+    st.send_failures = get(s.counters.send_failures);
+    st.recorded = get(s.counters.recorded);
+    st.record_dropped = s.record_ring ? s.record_ring->dropped() : 0;
+    st.latency = s.counters.latency.snapshot();
+    out.push_back(std::move(st));
+  }
+  return out;
+}
+
+void Pipeline::continue_sequences(const std::map<std::uint32_t, std::uint64_t>& next_sequence) {
+  if (started_) throw std::logic_error("Pipeline::continue_sequences after start");
+  publisher_->continue_from(next_sequence);
+}
+
+std::map<std::uint32_t, std::uint64_t> Pipeline::next_sequences() const { return final_sequences_; }
+
+std::unique_ptr<drivers::SampleLogWriter> Pipeline::release_recorder() { return std::move(writer_); }
+
+void Pipeline::adopt_recorder(std::unique_ptr<drivers::SampleLogWriter> writer) {
+  if (started_) throw std::logic_error("Pipeline::adopt_recorder after start");
+  writer_ = std::move(writer);
+}
+
+bool Pipeline::same_recording(const Pipeline& other) const {
+  const RecorderConfig& a = config_.recorder;
+  const RecorderConfig& b = other.config_.recorder;
+  return a.enabled && b.enabled && a.path == b.path && a.max_file_bytes == b.max_file_bytes &&
+         a.flush_interval == b.flush_interval && a.sync == b.sync && header_ == other.header_;
+}
+
+}  // namespace posefair::daemon

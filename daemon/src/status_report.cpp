@@ -1,0 +1,59 @@
+#include "posefair/daemon/status_report.hpp"
+
+#include <cinttypes>
+#include <cstdio>
+
+namespace posefair::daemon {
+namespace {
+
+const StreamStats* find(const std::vector<StreamStats>& v, std::uint32_t id) {
+  for (const StreamStats& s : v)
+    if (s.id == id) return &s;
+  return nullptr;
+}
+
+double rate(std::uint64_t now, std::uint64_t before, double seconds) {
+  return seconds > 0.0 && now >= before ? static_cast<double>(now - before) / seconds : 0.0;
+}
+
+double us(std::uint64_t ns) { return static_cast<double>(ns) / 1000.0; }
+
+}  // namespace
+
+std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, const std::vector<StreamStats>& previous,
+                                       double seconds) {
+  std::vector<std::string> lines;
+  for (const StreamStats& s : now) {
+    const StreamStats* p = find(previous, s.id);
+    char rate_text[48] = "";
+    if (p) std::snprintf(rate_text, sizeof rate_text, " (%.1f/s)", rate(s.received, p->received, seconds));
+    char buf[640];
+    std::snprintf(buf, sizeof buf,
+                  "stream %s (id %" PRIu32 ", %s%s): received %" PRIu64 "%s, dropped %" PRIu64 " (ring %" PRIu64
+                  ", publish %" PRIu64 "), rejected %" PRIu64 ", out-of-order %" PRIu64 ", emitted %" PRIu64
+                  ", clamped %" PRIu64 ", restarts %" PRIu64 ", published %" PRIu64 ", send failures %" PRIu64
+                  ", recorded %" PRIu64 " (dropped %" PRIu64 "), latency us p50 %.1f p90 %.1f p99 %.1f max %.1f",
+                  s.name.c_str(), s.id, s.driver.c_str(), s.driver_running ? "" : ", ended", s.received, rate_text,
+                  s.dropped(), s.ring_dropped, s.publish_dropped, s.rejected, s.out_of_order, s.emitted, s.clamped,
+                  s.restarts, s.published, s.send_failures, s.recorded, s.record_dropped,
+                  us(s.latency.percentile(50)), us(s.latency.percentile(90)), us(s.latency.percentile(99)),
+                  us(s.latency.max));
+    lines.emplace_back(buf);
+  }
+  return lines;
+}
+
+std::string status_line(const std::vector<StreamStats>& now, const std::vector<StreamStats>& previous, double seconds) {
+  std::string out;
+  for (const StreamStats& s : now) {
+    const StreamStats* p = find(previous, s.id);
+    const HistogramSnapshot interval = p ? s.latency.since(p->latency) : s.latency;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%s%s %.1f/s drop %" PRIu64 " p99 %.0fus", out.empty() ? "" : "; ", s.name.c_str(),
+                  p ? rate(s.emitted, p->emitted, seconds) : 0.0, s.dropped(), us(interval.percentile(99)));
+    out += buf;
+  }
+  return out;
+}
+
+}  // namespace posefair::daemon

@@ -1,0 +1,790 @@
+// posefaird's TOML configuration (docs/config.md): every key of a full config lands in its
+// DaemonConfig field, the example configs load, and malformed configs are refused with the
+// file, line and key of the problem.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "../support/test_files.hpp"
+#include "posefair/daemon/config.hpp"
+#include "posefair/drivers/replay_driver.hpp"
+
+namespace posefair::daemon {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+const std::filesystem::path kSourceDir = POSEFAIR_SOURCE_DIR;
+
+void write_file(const std::filesystem::path& p, const std::string& text) {
+  std::filesystem::create_directories(p.parent_path());
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+  ASSERT_TRUE(out.good()) << p;
+}
+
+Endpoint endpoint(const std::string& text) {
+  const auto e = Endpoint::parse(text);
+  EXPECT_TRUE(e.has_value()) << text;
+  return e.value_or(Endpoint{});
+}
+
+// Every key, most of them away from their defaults.
+constexpr const char* kFullConfig = R"toml(
+[daemon]
+exit_when_sources_end = true
+session_id = 4000000000
+
+[logging]
+level = "debug"
+target = "journald"
+status_interval = 15        # an integer where a float is expected
+
+[engine]
+window = 48
+lag = 3
+order = 3
+smoothing = 500
+epsilon_r = 0.04            # rotation angle; the engine gets half of it
+epsilon_t = 0.5
+gap = 0.5
+unit_tolerance = 0.05
+rate_hz = 200
+
+[[stream]]
+id = 7
+name = "replayed"
+ring_capacity = 256
+overflow = "drop-newest"
+[stream.driver]
+type = "replay"
+path = "data/poses.csv"
+timing = "fast"
+speed = 2.5
+schedule = "receive-time"
+loop = true
+rounds = 3
+format = "csv"
+csv_prefix = "gt_"
+skip_missing = true
+source_stream = 9
+[stream.engine]
+cutoff_hz = 10              # overrides [engine]'s smoothing; rate_hz from [engine]
+lag = 1
+solver = "gauss-newton"
+iterations = 3
+continuity = 0.5
+bound = "window"
+
+[[stream]]
+id = 8
+name = "generated"
+[stream.driver]
+type = "synthetic"
+rate_hz = 1000
+duration = 30
+rotation_noise = 0.02
+with_position = true
+seed = 42
+[stream.engine]
+solver = "sweeps"
+iterations = 4
+lambda_r = 0.2
+lambda_t = 0.6
+variant = "printed"
+smoothing_r = 50            # smoothing_t stays [engine]'s 500
+
+[[stream]]
+id = 9
+name = "defaults"
+driver = { type = "synthetic" }
+
+[[output]]
+encoding = "json"
+destinations = ["127.0.0.1", "[::1]:6000", "239.255.0.1:5800"]
+ttl = 4
+interface = "lo"
+loopback = false
+streams = [8, 7]
+angular_velocity = true
+
+[[output]]
+destinations = ["10.0.0.2:5701"]
+
+[recorder]
+path = "rec/out.pflog"
+max_file_bytes = 1048576
+flush_interval = 0.5
+overwrite = true
+sync = false
+ring_capacity = 8192
+)toml";
+
+TEST(Config, AFullConfigFillsEveryField) {
+  testing::ScratchDir dir("posefair-config-");
+  write_file(dir / "data/poses.csv", "t,qw,qx,qy,qz\n0,1,0,0,0\n");
+  std::filesystem::create_directories(dir / "rec");
+  const std::filesystem::path file = dir / "cfg.toml";
+  const DaemonConfig c = parse_config(kFullConfig, file);
+
+  EXPECT_EQ(c.source_file, file);
+  EXPECT_TRUE(c.daemon.exit_when_sources_end);
+  EXPECT_EQ(c.daemon.session_id, std::optional<std::uint32_t>(4000000000u));
+  EXPECT_EQ(c.logging.level, "debug");
+  EXPECT_EQ(c.logging.target, LogTarget::Journald);
+  EXPECT_EQ(c.logging.status_interval, 15.0);
+
+  ASSERT_EQ(c.streams.size(), 3u);
+  {
+    const StreamConfig& s = c.streams[0];
+    EXPECT_EQ(s.id, 7u);
+    EXPECT_EQ(s.name, "replayed");
+    EXPECT_EQ(s.ring_capacity, 256u);
+    EXPECT_EQ(s.overflow, OverflowPolicy::DropNewest);
+    ASSERT_EQ(s.driver.type, DriverType::Replay);
+    const ReplaySourceConfig& r = s.driver.replay;
+    EXPECT_EQ(r.path, dir.path() / "data" / "poses.csv");  // against the config's directory
+    EXPECT_TRUE(r.path.is_absolute());
+    EXPECT_EQ(r.options.timing, drivers::ReplayTiming::AsFastAsPossible);
+    EXPECT_EQ(r.options.speed, 2.5);
+    EXPECT_EQ(r.options.schedule, drivers::ReplaySchedule::ReceiveTime);
+    EXPECT_TRUE(r.options.loop);
+    EXPECT_EQ(r.options.max_rounds, 3u);
+    EXPECT_EQ(r.options.stream_id, 7u);
+    EXPECT_EQ(r.options.pose.format, std::optional<drivers::PoseFormat>(drivers::PoseFormat::Csv));
+    EXPECT_EQ(r.options.pose.csv_prefix, std::optional<std::string>("gt_"));
+    EXPECT_TRUE(r.options.pose.skip_missing);
+    EXPECT_EQ(r.options.pose.bvh_joint, "");
+    EXPECT_EQ(r.source_stream, std::optional<std::uint32_t>(9u));
+
+    const WindowConfig& e = s.engine;
+    EXPECT_EQ(e.window, 48);
+    EXPECT_EQ(e.lag, 1);
+    EXPECT_EQ(e.order, 3);
+    EXPECT_EQ(e.solver, WindowSolver::GaussNewton);
+    EXPECT_EQ(e.iterations, 3);
+    EXPECT_DOUBLE_EQ(e.smoothing_r, smoothing_for_cutoff(10.0, 200.0, 3));
+    EXPECT_DOUBLE_EQ(e.smoothing_t, smoothing_for_cutoff(10.0, 200.0, 3));
+    EXPECT_EQ(e.continuity, 0.5);
+    EXPECT_EQ(e.lambda_r, WindowConfig{}.lambda_r);
+    EXPECT_EQ(e.lambda_t, WindowConfig{}.lambda_t);
+    EXPECT_EQ(e.variant, OperatorVariant::Corrected);
+    EXPECT_DOUBLE_EQ(e.epsilon_r, 0.02);  // half of the 0.04 rad rotation angle
+    EXPECT_EQ(e.epsilon_t, 0.5);
+    EXPECT_EQ(e.bound, BoundPolicy::Window);
+    EXPECT_EQ(e.gate.gap_threshold, 0.5);
+    EXPECT_EQ(e.gate.unit_tolerance, 0.05);
+  }
+  {
+    const StreamConfig& s = c.streams[1];
+    EXPECT_EQ(s.id, 8u);
+    EXPECT_EQ(s.name, "generated");
+    ASSERT_EQ(s.driver.type, DriverType::Synthetic);
+    const SyntheticSourceConfig& g = s.driver.synthetic;
+    EXPECT_EQ(g.rate_hz, 1000.0);
+    EXPECT_EQ(g.duration, 30.0);
+    EXPECT_EQ(g.rotation_noise, 0.02);
+    EXPECT_TRUE(g.with_position);
+    EXPECT_EQ(g.seed, 42u);
+    const WindowConfig& e = s.engine;
+    EXPECT_EQ(e.window, 48);
+    EXPECT_EQ(e.lag, 3);
+    EXPECT_EQ(e.order, 3);
+    EXPECT_EQ(e.solver, WindowSolver::DampedSweeps);
+    EXPECT_EQ(e.iterations, 4);
+    EXPECT_EQ(e.smoothing_r, 50.0);
+    EXPECT_EQ(e.smoothing_t, 500.0);
+    EXPECT_EQ(e.continuity, 0.0);
+    EXPECT_EQ(e.lambda_r, 0.2);
+    EXPECT_EQ(e.lambda_t, 0.6);
+    EXPECT_EQ(e.variant, OperatorVariant::Printed);
+    EXPECT_DOUBLE_EQ(e.epsilon_r, 0.02);
+    EXPECT_EQ(e.bound, BoundPolicy::Sample);
+  }
+  {
+    // Only [engine] and the defaults.
+    const StreamConfig& s = c.streams[2];
+    EXPECT_EQ(s.id, 9u);
+    EXPECT_EQ(s.ring_capacity, 1024u);
+    EXPECT_EQ(s.overflow, OverflowPolicy::DropOldest);
+    ASSERT_EQ(s.driver.type, DriverType::Synthetic);
+    const SyntheticSourceConfig g = s.driver.synthetic;
+    EXPECT_EQ(g.rate_hz, 100.0);
+    EXPECT_EQ(g.duration, 0.0);
+    EXPECT_EQ(g.rotation_noise, 0.01);
+    EXPECT_FALSE(g.with_position);
+    EXPECT_EQ(g.seed, 1u);
+    const WindowConfig& e = s.engine;
+    EXPECT_EQ(e.window, 48);
+    EXPECT_EQ(e.lag, 3);
+    EXPECT_EQ(e.order, 3);
+    EXPECT_EQ(e.solver, WindowSolver::Linear);
+    EXPECT_EQ(e.iterations, 1);
+    EXPECT_EQ(e.smoothing_r, 500.0);
+    EXPECT_EQ(e.smoothing_t, 500.0);
+    EXPECT_DOUBLE_EQ(e.epsilon_r, 0.02);
+    EXPECT_EQ(e.epsilon_t, 0.5);
+    EXPECT_EQ(e.gate.gap_threshold, 0.5);
+    EXPECT_EQ(e.gate.unit_tolerance, 0.05);
+  }
+
+  ASSERT_EQ(c.outputs.size(), 2u);
+  {
+    const OutputConfig& o = c.outputs[0];
+    EXPECT_EQ(o.encoding, WireEncoding::kJson);
+    ASSERT_EQ(o.destinations.size(), 3u);
+    EXPECT_EQ(o.destinations[0], endpoint("127.0.0.1:5700"));  // the default port
+    EXPECT_EQ(o.destinations[1], endpoint("[::1]:6000"));
+    EXPECT_EQ(o.destinations[2], endpoint("239.255.0.1:5800"));
+    EXPECT_EQ(o.send.multicast_ttl, 4);
+    EXPECT_EQ(o.send.interface.name_or_address, "lo");
+    EXPECT_FALSE(o.send.multicast_loopback);
+    EXPECT_EQ(o.streams, (std::vector<std::uint32_t>{8, 7}));
+    EXPECT_TRUE(o.angular_velocity);
+  }
+  {
+    const OutputConfig& o = c.outputs[1];
+    EXPECT_EQ(o.encoding, WireEncoding::kBinary);
+    ASSERT_EQ(o.destinations.size(), 1u);
+    EXPECT_EQ(o.destinations[0], endpoint("10.0.0.2:5701"));
+    EXPECT_EQ(o.send.multicast_ttl, 1);
+    EXPECT_EQ(o.send.interface.name_or_address, "");
+    EXPECT_TRUE(o.send.multicast_loopback);
+    EXPECT_TRUE(o.streams.empty());
+    EXPECT_FALSE(o.angular_velocity);
+  }
+
+  EXPECT_TRUE(c.recorder.enabled);  // the table is there
+  EXPECT_EQ(c.recorder.path, dir.path() / "rec" / "out.pflog");
+  EXPECT_EQ(c.recorder.max_file_bytes, 1048576u);
+  EXPECT_EQ(c.recorder.flush_interval, 0.5);
+  EXPECT_TRUE(c.recorder.overwrite);
+  EXPECT_FALSE(c.recorder.sync);
+  EXPECT_EQ(c.recorder.ring_capacity, 8192u);
+
+  // load_config reads the same from the file, and resolves against the file's directory,
+  // not the working directory.
+  write_file(file, kFullConfig);
+  const DaemonConfig loaded = load_config(file);
+  EXPECT_EQ(loaded.source_file, file);
+  EXPECT_EQ(loaded.streams.at(0).driver.replay.path, dir.path() / "data" / "poses.csv");
+  EXPECT_EQ(loaded.recorder.path, dir.path() / "rec" / "out.pflog");
+}
+
+TEST(Config, AMinimalConfigGetsEveryDefault) {
+  const DaemonConfig c = parse_config(R"toml(
+[[stream]]
+id = 0
+name = "s"
+driver = { type = "synthetic" }
+)toml",
+                                      "/nonexistent/minimal.toml");
+  EXPECT_FALSE(c.daemon.exit_when_sources_end);
+  EXPECT_FALSE(c.daemon.session_id.has_value());
+  EXPECT_EQ(c.logging.level, "info");
+  EXPECT_EQ(c.logging.target, LogTarget::Auto);
+  EXPECT_EQ(c.logging.status_interval, 60.0);
+  EXPECT_TRUE(c.outputs.empty());
+  EXPECT_FALSE(c.recorder.enabled);
+  ASSERT_EQ(c.streams.size(), 1u);
+  const WindowConfig d;
+  const WindowConfig& e = c.streams[0].engine;
+  EXPECT_EQ(e.window, d.window);
+  EXPECT_EQ(e.lag, d.lag);
+  EXPECT_EQ(e.order, d.order);
+  EXPECT_EQ(e.solver, d.solver);
+  EXPECT_EQ(e.iterations, d.iterations);
+  EXPECT_EQ(e.smoothing_r, d.smoothing_r);
+  EXPECT_EQ(e.smoothing_t, d.smoothing_t);
+  EXPECT_EQ(e.continuity, d.continuity);
+  EXPECT_EQ(e.lambda_r, d.lambda_r);
+  EXPECT_EQ(e.lambda_t, d.lambda_t);
+  EXPECT_EQ(e.variant, d.variant);
+  EXPECT_EQ(e.epsilon_r, d.epsilon_r);
+  EXPECT_EQ(e.epsilon_t, d.epsilon_t);
+  EXPECT_EQ(e.bound, d.bound);
+  EXPECT_EQ(e.gate.gap_threshold, d.gate.gap_threshold);
+  EXPECT_EQ(e.gate.unit_tolerance, d.gate.unit_tolerance);
+}
+
+TEST(Config, TheMostSpecificTableDecidesTheSmoothing) {
+  testing::ScratchDir dir("posefair-config-");
+  write_file(dir / "poses.csv", "t,qw,qx,qy,qz\n0,1,0,0,0\n");
+  const DaemonConfig c = parse_config(R"toml(
+[engine]
+order = 3
+cutoff_hz = 5
+rate_hz = 100
+
+[[stream]]                 # smoothing here replaces [engine]'s cutoff_hz for both
+id = 1
+name = "a"
+driver = { type = "replay", path = "poses.csv" }
+engine = { smoothing = 300 }
+
+[[stream]]                 # smoothing_t replaces only the translational half
+id = 2
+name = "b"
+driver = { type = "replay", path = "poses.csv" }
+engine = { smoothing_t = 300 }
+
+[[stream]]                 # [engine]'s cutoff at [engine]'s rate
+id = 3
+name = "c"
+driver = { type = "replay", path = "poses.csv" }
+
+[[stream]]                 # a synthetic driver's rate comes before [engine]'s
+id = 4
+name = "d"
+driver = { type = "synthetic", rate_hz = 400 }
+
+[[stream]]                 # the stream's own rate_hz comes first
+id = 5
+name = "e"
+driver = { type = "synthetic", rate_hz = 400 }
+engine = { rate_hz = 50 }
+
+[[stream]]                 # its own cutoff_hz and order, at the synthetic driver's default 100 Hz
+id = 6
+name = "f"
+driver = { type = "synthetic" }
+engine = { cutoff_hz = 2, order = 2 }
+)toml",
+                                      dir / "cfg.toml");
+  ASSERT_EQ(c.streams.size(), 6u);
+  const double at100 = smoothing_for_cutoff(5.0, 100.0, 3);
+  EXPECT_EQ(c.streams[0].engine.smoothing_r, 300.0);
+  EXPECT_EQ(c.streams[0].engine.smoothing_t, 300.0);
+  EXPECT_DOUBLE_EQ(c.streams[1].engine.smoothing_r, at100);
+  EXPECT_EQ(c.streams[1].engine.smoothing_t, 300.0);
+  EXPECT_DOUBLE_EQ(c.streams[2].engine.smoothing_r, at100);
+  EXPECT_DOUBLE_EQ(c.streams[2].engine.smoothing_t, at100);
+  EXPECT_DOUBLE_EQ(c.streams[3].engine.smoothing_r, smoothing_for_cutoff(5.0, 400.0, 3));
+  EXPECT_DOUBLE_EQ(c.streams[4].engine.smoothing_r, smoothing_for_cutoff(5.0, 50.0, 3));
+  EXPECT_DOUBLE_EQ(c.streams[5].engine.smoothing_t, smoothing_for_cutoff(2.0, 100.0, 2));
+
+  // And the other way round: a stream's cutoff_hz replaces [engine]'s smoothing.
+  const DaemonConfig d = parse_config(R"toml(
+[engine]
+smoothing_r = 7
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 250 }
+engine = { cutoff_hz = 10 }
+)toml",
+                                      dir / "cfg.toml");
+  EXPECT_DOUBLE_EQ(d.streams.at(0).engine.smoothing_r, smoothing_for_cutoff(10.0, 250.0, 2));
+  EXPECT_DOUBLE_EQ(d.streams.at(0).engine.smoothing_t, smoothing_for_cutoff(10.0, 250.0, 2));
+}
+
+TEST(Config, TheExampleConfigsLoad) {
+  for (const char* name : {"config/minimal.toml", "config/robot.toml", "config/vr-rig.toml", "data/demo/posefaird.toml"}) {
+    SCOPED_TRACE(name);
+    try {
+      const DaemonConfig c = load_config(kSourceDir / name);
+      EXPECT_FALSE(c.streams.empty());
+    } catch (const ConfigError& e) {
+      ADD_FAILURE() << e.what();
+    }
+  }
+}
+
+TEST(Config, TheDemoConfigReplaysTheBundledExcerpt) {
+  const DaemonConfig c = load_config(kSourceDir / "data/demo/posefaird.toml");
+  EXPECT_TRUE(c.daemon.exit_when_sources_end);
+  ASSERT_EQ(c.streams.size(), 1u);
+  const StreamConfig& s = c.streams[0];
+  EXPECT_EQ(s.id, 1u);
+  EXPECT_EQ(s.name, "broad07");
+  ASSERT_EQ(s.driver.type, DriverType::Replay);
+  EXPECT_TRUE(std::filesystem::equivalent(s.driver.replay.path, kSourceDir / "data/demo/broad-07-excerpt.csv"));
+  EXPECT_EQ(s.driver.replay.options.timing, drivers::ReplayTiming::Original);
+  EXPECT_EQ(s.driver.replay.options.speed, 1.0);
+  EXPECT_EQ(s.engine.order, 3);
+  EXPECT_EQ(s.engine.window, 32);
+  EXPECT_EQ(s.engine.lag, 0);
+  EXPECT_DOUBLE_EQ(s.engine.smoothing_r, smoothing_for_cutoff(8.0, 285.7, 3));
+  EXPECT_DOUBLE_EQ(s.engine.smoothing_t, smoothing_for_cutoff(8.0, 285.7, 3));
+  EXPECT_DOUBLE_EQ(s.engine.epsilon_r, 0.01);
+  EXPECT_DOUBLE_EQ(s.engine.epsilon_t, 0.002);
+  ASSERT_EQ(c.outputs.size(), 1u);
+  EXPECT_EQ(c.outputs[0].encoding, WireEncoding::kBinary);
+  ASSERT_EQ(c.outputs[0].destinations.size(), 1u);
+  EXPECT_EQ(c.outputs[0].destinations[0], endpoint("127.0.0.1:5700"));
+  // The replay driver reads the file with the options as configured.
+  const drivers::ReplayDriver replay(s.driver.replay.path, s.driver.replay.options);
+  EXPECT_EQ(replay.samples().size(), 2000u);
+  EXPECT_EQ(replay.samples().front().stream_id, 1u);
+}
+
+struct BadConfig {
+  const char* name;
+  const char* toml;
+  const char* expected;  // a substring of what()
+  std::uint32_t line;    // 0: the message carries no line
+};
+
+// Files in the scratch directory the rows may name: poses.csv, walk.bvh (contents unread).
+const std::vector<BadConfig> kBadConfigs = {
+    {"syntax error", R"([[stream]]
+id = = 1
+)", "Error while parsing", 2},
+    {"unknown top-level key", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[loging]
+level = "info"
+)", "loging: unknown key (did you mean 'logging'?)", 5},
+    {"unknown key in [engine]", R"([engine]
+windw = 16
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "engine.windw: unknown key (did you mean 'window'?)", 2},
+    {"unknown key without a near one", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+colour = "red"
+)", "stream[1].colour: unknown key", 5},
+    {"wrong type", R"([[stream]]
+id = 1
+name = 5
+driver = { type = "synthetic" }
+)", "stream[1].name: expected a string, got an integer", 3},
+    {"float for integer", R"([engine]
+window = 32.0
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "engine.window: expected an integer, got a float", 2},
+    {"window out of range", R"([engine]
+window = 5000
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "engine.window: out of range: must be in [2, 4096], got 5000", 2},
+    {"lag not below window", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.engine]
+window = 16
+lag = 16
+)", "stream[1].engine.lag: lag must be in [0, window-1] = [0, 15], got 16", 7},
+    {"order 4", R"([engine]
+order = 4
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "engine.order: must be 2 or 3, got 4", 2},
+    {"window too small for the order, from [engine]", R"([engine]
+order = 3
+window = 3
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "engine.window: window must hold 4 to 4096 samples for order 3, got 3 (for stream[1] 'a')", 3},
+    {"unknown solver", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+engine = { solver = "newton" }
+)", "stream[1].engine.solver: expected one of 'linear', 'gauss-newton', 'sweeps', got 'newton'", 5},
+    {"duplicate stream id", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[stream]]
+id = 1
+name = "b"
+driver = { type = "synthetic" }
+)", "stream[2].id: duplicate stream id 1 (also stream[1])", 6},
+    {"duplicate stream name", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[stream]]
+id = 2
+name = "a"
+driver = { type = "synthetic" }
+)", "stream[2].name: duplicate stream name 'a' (also stream[1])", 7},
+    {"empty name", R"([[stream]]
+id = 1
+name = ""
+driver = { type = "synthetic" }
+)", "stream[1].name: must not be empty", 3},
+    {"missing id", R"([daemon]
+exit_when_sources_end = true
+
+[[stream]]
+name = "a"
+driver = { type = "synthetic" }
+)", "stream[1].id: missing required key", 4},
+    {"missing driver", R"([[stream]]
+id = 1
+name = "a"
+)", "stream[1].driver: missing required key", 1},
+    {"unknown driver type", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "serial"
+)", "stream[1].driver.type: expected one of 'replay', 'synthetic', got 'serial'", 5},
+    {"replay key on a synthetic driver", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", path = "poses.csv" }
+)", "stream[1].driver.path: unknown key for driver type synthetic (it belongs to type replay)", 4},
+    {"nonexistent replay path", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "replay"
+path = "no-such-file.csv"
+)", "stream[1].driver.path: no such file", 6},
+    {"BVH without a joint", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "replay"
+path = "walk.bvh"
+)", "stream[1].driver.joint: missing required key", 4},
+    {"negative speed", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "replay"
+path = "poses.csv"
+speed = -1
+)", "stream[1].driver.speed: out of range: must be > 0, got -1", 7},
+    {"synthetic rate too high", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 200000 }
+)", "stream[1].driver.rate_hz: out of range: must be in (0, 100000], got 200000", 4},
+    {"bad destination", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[output]]
+destinations = ["127.0.0.1", "localhost:5700"]
+)", "output[1].destinations[2]: not a destination: 'localhost:5700'", 6},
+    {"no destinations", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[output]]
+destinations = []
+)", "output[1].destinations: must list at least one destination", 6},
+    {"output naming an unknown stream", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[output]]
+destinations = ["127.0.0.1"]
+streams = [1, 5]
+)", "output[1].streams[2]: no [[stream]] has id 5", 7},
+    {"ring capacity not a power of two", R"([[stream]]
+id = 1
+name = "a"
+ring_capacity = 1000
+driver = { type = "synthetic" }
+)", "stream[1].ring_capacity: must be a power of two in [2, 1048576], got 1000", 4},
+    {"ttl 300", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[output]]
+destinations = ["239.255.0.1"]
+ttl = 300
+)", "output[1].ttl: out of range: must be in [0, 255], got 300", 7},
+    {"bad overflow policy", R"([[stream]]
+id = 1
+name = "a"
+overflow = "drop-all"
+driver = { type = "synthetic" }
+)", "stream[1].overflow: expected one of 'drop-oldest', 'drop-newest', got 'drop-all'", 4},
+    {"no [[stream]] at all", R"([daemon]
+exit_when_sources_end = true
+)", "stream: missing required key: at least one [[stream]] table is needed", 0},
+    {"[stream] instead of [[stream]]", R"([stream]
+id = 1
+)", "stream: expected an array of tables ([[stream]]), got a table", 1},
+    {"cutoff_hz without rate_hz", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "replay", path = "poses.csv" }
+[stream.engine]
+cutoff_hz = 8
+)", "stream[1].engine.cutoff_hz: needs rate_hz", 6},
+    {"cutoff_hz in [engine] without rate_hz", R"([engine]
+cutoff_hz = 8
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "replay", path = "poses.csv" }
+)", "engine.cutoff_hz: needs rate_hz, the stream's sample rate in Hz (in [engine] or [stream.engine]) for stream[1] 'a'", 2},
+    {"cutoff_hz above half the rate", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+engine = { cutoff_hz = 60 }
+)", "stream[1].engine.cutoff_hz: must be below half the sample rate", 5},
+    {"cutoff_hz and smoothing in one table", R"([engine]
+smoothing = 10
+rate_hz = 100
+cutoff_hz = 5
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "engine.cutoff_hz: cannot be given together with engine.smoothing (line 2)", 4},
+    {"unstable continuity", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.engine]
+order = 3
+window = 32
+lag = 0
+smoothing = 100
+continuity = 10
+)", "stream[1].engine.continuity: continuity 10.000000 with smoothing 100.000000, window 32 and lag 0 makes the output recursion unstable", 10},
+    {"window bound with the linear solver", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+engine = { bound = "window" }
+)", "stream[1].engine.bound: the window bound policy needs an iterative solver", 5},
+    {"zero epsilon_r", R"([engine]
+epsilon_r = 0
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "engine.epsilon_r: out of range: must be > 0, got 0", 2},
+    {"recorder with a nonexistent directory", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[recorder]
+path = "nowhere/rec.pflog"
+)", "recorder.path: no such directory", 6},
+    {"recorder without a path", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+
+[recorder]
+sync = false
+)", "recorder.path: missing required key", 6},
+    {"session id out of range", R"([daemon]
+session_id = -1
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "daemon.session_id: out of range: must be in [0, 4294967295], got -1", 2},
+    {"log level typo", R"([logging]
+level = "warning"
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "logging.level: expected one of 'trace', 'debug', 'info', 'warn', 'error', 'critical', 'off', got 'warning'", 2},
+    {"a table that is not one", R"(daemon = 5
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "daemon: expected a table ([daemon]), got an integer", 1},
+};
+
+TEST(Config, MalformedConfigsAreRefusedWithFileLineAndKey) {
+  testing::ScratchDir dir("posefair-config-");
+  write_file(dir / "poses.csv", "t,qw,qx,qy,qz\n0,1,0,0,0\n");
+  write_file(dir / "walk.bvh", "");
+  const std::filesystem::path file = dir / "cfg.toml";
+  EXPECT_GE(kBadConfigs.size(), 25u);
+  for (const BadConfig& bad : kBadConfigs) {
+    SCOPED_TRACE(bad.name);
+    try {
+      parse_config(bad.toml, file);
+      ADD_FAILURE() << "accepted";
+    } catch (const ConfigError& e) {
+      const std::string what = e.what();
+      EXPECT_THAT(what, HasSubstr(bad.expected));
+      EXPECT_EQ(e.file(), file.string());
+      EXPECT_EQ(e.line(), bad.line) << what;
+      if (bad.line > 0) {
+        EXPECT_THAT(what, StartsWith(file.string() + ":" + std::to_string(bad.line) + ":")) << what;
+        EXPECT_GT(e.column(), 0u) << what;
+      } else {
+        EXPECT_THAT(what, StartsWith(file.string() + ": ")) << what;
+      }
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "not a ConfigError: " << e.what();
+    }
+  }
+}
+
+TEST(Config, TheMessageIsFileLineColumnKeyMessage) {
+  try {
+    parse_config(R"toml(
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+
+[[stream]]
+id = 2
+driver = { type = "synthetic" }
+)toml",
+                 "cfg.toml");
+    FAIL() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_STREQ(e.what(), "cfg.toml:7:1: stream[2].name: missing required key");
+    EXPECT_EQ(e.file(), "cfg.toml");
+    EXPECT_EQ(e.line(), 7u);
+    EXPECT_EQ(e.column(), 1u);
+    EXPECT_EQ(e.key(), "stream[2].name");
+    EXPECT_EQ(e.message(), "missing required key");
+  }
+  try {
+    parse_config("[[stream]]\nid = 1\nname = \"a\"\ndriver = { type = \"synthetic\" }\n[engine]\n  lagg = 2\n", "cfg.toml");
+    FAIL() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_STREQ(e.what(), "cfg.toml:6:3: engine.lagg: unknown key (did you mean 'lag'?)");
+  }
+}
+
+TEST(Config, AMissingFileCannotBeRead) {
+  testing::ScratchDir dir("posefair-config-");
+  const std::filesystem::path file = dir / "absent.toml";
+  try {
+    load_config(file);
+    FAIL() << "loaded";
+  } catch (const ConfigError& e) {
+    EXPECT_STREQ(e.what(), (file.string() + ": cannot read: No such file or directory").c_str());
+    EXPECT_EQ(e.line(), 0u);
+    EXPECT_EQ(e.key(), "");
+  }
+}
+
+}  // namespace
+}  // namespace posefair::daemon
