@@ -1,4 +1,5 @@
 #include "bench_quality_command.hpp"
+#include "bench_latency_command.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -277,6 +278,7 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   quality->add_option("-o,--output", *out, "folder for quality-runs.csv and quality-summary.csv")->capture_default_str();
   quality->add_flag("--quick", *quick, "synthetic data only, fewer configurations (seconds, for tests)");
   quality->callback([=, &exit_code] { exit_code = bench_quality(*data, *out, *quick); });
+  add_bench_latency_command(*bench, exit_code);
 }
 
 }  // namespace posefair::tools

@@ -15,6 +15,7 @@ packages=(
   libspdlog-dev          # posefaird's logging (stderr or journald)
   libsystemd-dev         # sd_notify and the journald log sink
   libboost-dev           # Boost.Lockfree, the ring benchmark's yardstick
+  systemd                # systemd-analyze verify checks config/posefaird.service
   python3                # the Python subscriber client and its test
   zlib1g-dev             # CRC-32 of the sample log (drivers)
 )

@@ -1,0 +1,167 @@
+#include "bench_latency_command.hpp"
+
+#include <sys/resource.h>
+#include <time.h>
+
+#include <atomic>
+#include <chrono>
+#include <cinttypes>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "exit_codes.hpp"
+#include "posefair/daemon/config.hpp"
+#include "posefair/daemon/pipeline.hpp"
+#include "posefair/daemon/udp_socket.hpp"
+#include "posefair/daemon/wire_protocol.hpp"
+
+namespace posefair::tools {
+namespace {
+
+struct LatencyOptions {
+  int streams = 16;
+  double rate = 1000.0;
+  double duration = 10.0;
+  int window = 32;
+  int lag = 0;
+  std::string solver = "linear";
+  int ring_capacity = 1024;
+};
+
+double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
+
+double process_cpu_seconds() {
+  rusage ru{};
+  ::getrusage(RUSAGE_SELF, &ru);
+  return seconds(ru.ru_utime) + seconds(ru.ru_stime);
+}
+
+double thread_cpu_seconds() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+void merge(daemon::HistogramSnapshot& into, const daemon::HistogramSnapshot& s) {
+  if (s.count == 0) return;
+  into.min = into.count == 0 ? s.min : std::min(into.min, s.min);
+  into.max = std::max(into.max, s.max);
+  into.count += s.count;
+  into.sum += s.sum;
+  into.mean = static_cast<double>(into.sum) / static_cast<double>(into.count);
+  for (std::size_t i = 0; i < into.buckets.size(); ++i) into.buckets[i] += s.buckets[i];
+}
+
+int bench_latency(const LatencyOptions& o) {
+  // The receiver: a loopback socket drained by its own thread, counting what arrives and the
+  // gaps in each stream's sequence numbers.
+  daemon::ReceiveOptions ro;
+  ro.receive_buffer_bytes = 8 << 20;
+  daemon::UdpSocket socket = daemon::UdpSocket::bind(*daemon::Endpoint::parse("127.0.0.1:0"), ro);
+  const std::uint16_t port = socket.local_endpoint().port();
+
+  std::string toml = "[logging]\nlevel = \"warn\"\n";
+  toml += "[engine]\nwindow = " + std::to_string(o.window) + "\nlag = " + std::to_string(o.lag) + "\nsolver = \"" +
+          o.solver + "\"\ncutoff_hz = 20.0\nepsilon_r = 0.05\n";
+  for (int i = 0; i < o.streams; ++i) {
+    toml += "[[stream]]\nid = " + std::to_string(i + 1) + "\nname = \"s" + std::to_string(i + 1) +
+            "\"\nring_capacity = " + std::to_string(o.ring_capacity) + "\n[stream.driver]\ntype = \"synthetic\"\nrate_hz = " +
+            std::to_string(o.rate) + "\nduration = " + std::to_string(o.duration) + "\nseed = " + std::to_string(i + 1) + "\n";
+  }
+  toml += "[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(port) + "\"]\n";
+  daemon::DaemonConfig config;
+  try {
+    config = daemon::parse_config(toml, "bench-latency.toml");
+  } catch (const daemon::ConfigError& e) {
+    std::fprintf(stderr, "posefair bench latency: %s\n", e.what());
+    return kExitUsage;
+  }
+
+  std::atomic<bool> stop{false};
+  std::atomic<std::uint64_t> datagrams{0}, lost{0};
+  double receiver_cpu = 0.0;
+  std::thread receiver([&] {
+    std::vector<std::uint8_t> buffer(daemon::kMaxDatagramSize + 1);
+    std::map<std::uint32_t, std::uint64_t> next;
+    while (!stop.load(std::memory_order_acquire)) {
+      const auto d = socket.receive(buffer, std::chrono::milliseconds(50));
+      if (!d) continue;
+      const auto r = daemon::decode_datagram(std::span<const std::uint8_t>(buffer.data(), d->size));
+      if (!r) continue;
+      datagrams.fetch_add(1, std::memory_order_relaxed);
+      auto [it, fresh] = next.try_emplace(r.message.stream, 0);
+      if (r.message.sequence > it->second) lost.fetch_add(r.message.sequence - it->second, std::memory_order_relaxed);
+      it->second = r.message.sequence + 1;
+    }
+    receiver_cpu = thread_cpu_seconds();
+  });
+
+  std::printf("bench latency: %d streams at %.0f Hz for %.1f s, window %d, lag %d, %s solver, ring %d\n", o.streams, o.rate,
+              o.duration, o.window, o.lag, o.solver.c_str(), o.ring_capacity);
+  const double cpu0 = process_cpu_seconds();
+  const auto t0 = std::chrono::steady_clock::now();
+  {
+    daemon::Pipeline pipeline(config, 0x62656e63, {});
+    pipeline.start();
+    while (!pipeline.sources_ended()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    pipeline.stop();
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the last datagrams
+    stop.store(true, std::memory_order_release);
+    receiver.join();
+    const double cpu = process_cpu_seconds() - cpu0 - receiver_cpu;
+
+    daemon::HistogramSnapshot all;
+    std::uint64_t received = 0, emitted = 0, ring_dropped = 0, publish_dropped = 0, rejected = 0, out_of_order = 0,
+                  published = 0, failures = 0, worst_p99 = 0;
+    for (const daemon::StreamStats& s : pipeline.stats()) {
+      merge(all, s.latency);
+      received += s.received;
+      emitted += s.emitted;
+      ring_dropped += s.ring_dropped;
+      publish_dropped += s.publish_dropped;
+      rejected += s.rejected;
+      out_of_order += s.out_of_order;
+      published += s.published;
+      failures += s.send_failures;
+      worst_p99 = std::max(worst_p99, s.latency.percentile(99));
+    }
+    const auto us = [](std::uint64_t ns) { return static_cast<double>(ns) / 1000.0; };
+    std::printf("samples     %" PRIu64 " handed over (%.0f/s), %" PRIu64 " emitted, %" PRIu64 " published\n", received,
+                static_cast<double>(received) / wall, emitted, published);
+    std::printf("latency us  p50 %.1f  p90 %.1f  p99 %.1f  p99.9 %.1f  max %.1f  (worst stream p99 %.1f)\n",
+                us(all.percentile(50)), us(all.percentile(90)), us(all.percentile(99)), us(all.percentile(99.9)),
+                us(all.max), us(worst_p99));
+    const std::uint64_t accounted = emitted + ring_dropped + rejected + out_of_order;
+    std::printf("drops       ring %" PRIu64 ", publish %" PRIu64 ", rejected %" PRIu64 ", out-of-order %" PRIu64
+                ", send failures %" PRIu64 "; unaccounted %" PRId64 "\n",
+                ring_dropped, publish_dropped, rejected, out_of_order, failures,
+                static_cast<std::int64_t>(received) - static_cast<std::int64_t>(accounted));
+    std::printf("receiver    %" PRIu64 " datagrams, %" PRIu64 " lost (sequence gaps)\n", datagrams.load(), lost.load());
+    std::printf("cpu         %.3f s in %.2f s wall: %.1f%% of one core, %.2f%% per stream at %.0f Hz (receiver excluded)\n",
+                cpu, wall, 100.0 * cpu / wall, 100.0 * cpu / wall / o.streams, o.rate);
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void add_bench_latency_command(CLI::App& bench, int& exit_code) {
+  auto o = std::make_shared<LatencyOptions>();
+  auto* cmd = bench.add_subcommand("latency", "posefaird's processing latency and CPU with N synthetic streams");
+  cmd->add_option("--streams", o->streams, "number of streams")->capture_default_str()->check(CLI::Range(1, 256));
+  cmd->add_option("--rate", o->rate, "samples per second per stream")->capture_default_str()->check(CLI::Range(1.0, 100000.0));
+  cmd->add_option("--duration", o->duration, "seconds")->capture_default_str()->check(CLI::Range(0.1, 3600.0));
+  cmd->add_option("--window", o->window, "window W")->capture_default_str();
+  cmd->add_option("--lag", o->lag, "lag L")->capture_default_str();
+  cmd->add_option("--solver", o->solver, "linear, gauss-newton or sweeps")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"linear", "gauss-newton", "sweeps"}));
+  cmd->add_option("--ring", o->ring_capacity, "ring capacity per stream (power of two)")->capture_default_str();
+  cmd->callback([o, &exit_code] { exit_code = bench_latency(*o); });
+}
+
+}  // namespace posefair::tools
