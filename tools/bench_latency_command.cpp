@@ -29,6 +29,8 @@ struct LatencyOptions {
   int lag = 0;
   std::string solver = "linear";
   int ring_capacity = 1024;
+  int realtime_priority = 0;
+  bool aligned = false;  // all streams sample at the same instant (one sync line)
 };
 
 double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
@@ -63,13 +65,14 @@ int bench_latency(const LatencyOptions& o) {
   daemon::UdpSocket socket = daemon::UdpSocket::bind(*daemon::Endpoint::parse("127.0.0.1:0"), ro);
   const std::uint16_t port = socket.local_endpoint().port();
 
-  std::string toml = "[logging]\nlevel = \"warn\"\n";
+  std::string toml = "[logging]\nlevel = \"warn\"\n[daemon]\nrealtime_priority = " + std::to_string(o.realtime_priority) + "\n";
   toml += "[engine]\nwindow = " + std::to_string(o.window) + "\nlag = " + std::to_string(o.lag) + "\nsolver = \"" +
           o.solver + "\"\ncutoff_hz = 20.0\nepsilon_r = 0.05\n";
   for (int i = 0; i < o.streams; ++i) {
     toml += "[[stream]]\nid = " + std::to_string(i + 1) + "\nname = \"s" + std::to_string(i + 1) +
             "\"\nring_capacity = " + std::to_string(o.ring_capacity) + "\n[stream.driver]\ntype = \"synthetic\"\nrate_hz = " +
-            std::to_string(o.rate) + "\nduration = " + std::to_string(o.duration) + "\nseed = " + std::to_string(i + 1) + "\n";
+            std::to_string(o.rate) + "\nduration = " + std::to_string(o.duration) + "\nseed = " + std::to_string(i + 1) +
+            "\nphase = " + std::to_string(o.aligned ? 0.0 : static_cast<double>(i) / o.streams) + "\n";
   }
   toml += "[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(port) + "\"]\n";
   daemon::DaemonConfig config;
@@ -99,13 +102,14 @@ int bench_latency(const LatencyOptions& o) {
     receiver_cpu = thread_cpu_seconds();
   });
 
-  std::printf("bench latency: %d streams at %.0f Hz for %.1f s, window %d, lag %d, %s solver, ring %d\n", o.streams, o.rate,
-              o.duration, o.window, o.lag, o.solver.c_str(), o.ring_capacity);
+  std::printf("bench latency: %d streams at %.0f Hz for %.1f s, window %d, lag %d, %s solver, ring %d, realtime priority %d, %s\n",
+              o.streams, o.rate, o.duration, o.window, o.lag, o.solver.c_str(), o.ring_capacity, o.realtime_priority,
+              o.aligned ? "phases aligned" : "phases spread");
   const double cpu0 = process_cpu_seconds();
   const auto t0 = std::chrono::steady_clock::now();
   {
     daemon::Pipeline pipeline(config, 0x62656e63, {});
-    pipeline.start();
+    for (const std::string& w : pipeline.start()) std::fprintf(stderr, "warning: %s\n", w.c_str());
     while (!pipeline.sources_ended()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
     pipeline.stop();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -160,6 +164,10 @@ void add_bench_latency_command(CLI::App& bench, int& exit_code) {
   cmd->add_option("--solver", o->solver, "linear, gauss-newton or sweeps")
       ->capture_default_str()
       ->check(CLI::IsMember({"linear", "gauss-newton", "sweeps"}));
+  cmd->add_option("--realtime-priority", o->realtime_priority, "SCHED_FIFO priority of engine and publisher (0: off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 99));
+  cmd->add_flag("--aligned", o->aligned, "all streams sample at the same instant (default: phases spread over the period)");
   cmd->add_option("--ring", o->ring_capacity, "ring capacity per stream (power of two)")->capture_default_str();
   cmd->callback([o, &exit_code] { exit_code = bench_latency(*o); });
 }

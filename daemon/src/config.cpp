@@ -121,7 +121,7 @@ bool before(const toml::source_position& a, const toml::source_position& b) {
 }
 
 constexpr std::string_view kRootKeys[] = {"daemon", "logging", "engine", "stream", "output", "recorder"};
-constexpr std::string_view kDaemonKeys[] = {"exit_when_sources_end", "session_id"};
+constexpr std::string_view kDaemonKeys[] = {"exit_when_sources_end", "session_id", "realtime_priority"};
 constexpr std::string_view kLoggingKeys[] = {"level", "target", "status_interval"};
 constexpr std::string_view kEngineKeys[] = {
     "window",   "lag",      "order",    "solver",    "iterations", "smoothing", "smoothing_r",
@@ -130,7 +130,7 @@ constexpr std::string_view kEngineKeys[] = {
 constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "overflow", "driver", "engine"};
 constexpr std::string_view kReplayKeys[] = {"type",   "path",   "timing",     "speed",        "schedule",     "loop",
                                             "rounds", "format", "joint",      "csv_prefix",   "skip_missing", "source_stream"};
-constexpr std::string_view kSyntheticKeys[] = {"type", "rate_hz", "duration", "rotation_noise", "with_position", "seed"};
+constexpr std::string_view kSyntheticKeys[] = {"type", "rate_hz", "duration", "rotation_noise", "with_position", "seed", "phase"};
 constexpr std::string_view kOutputKeys[] = {"encoding", "destinations", "ttl",          "interface",
                                             "loopback", "streams",      "angular_velocity"};
 constexpr std::string_view kRecorderKeys[] = {"path",  "enabled", "max_file_bytes", "flush_interval",
@@ -340,6 +340,8 @@ class Parser {
     DaemonSettings d;
     if (const toml::node* n = t.get("exit_when_sources_end")) d.exit_when_sources_end = get_bool(*n, join_key(prefix, "exit_when_sources_end"));
     if (const toml::node* n = t.get("session_id")) d.session_id = get_u32(*n, join_key(prefix, "session_id"));
+    if (const toml::node* n = t.get("realtime_priority"))
+      d.realtime_priority = static_cast<int>(get_int(*n, join_key(prefix, "realtime_priority"), 0, 99));
     return d;
   }
 
@@ -612,6 +614,7 @@ class Parser {
     if (const toml::node* n = t.get("rotation_noise")) g.rotation_noise = get_float(*n, key("rotation_noise"), kNonNegative);
     if (const toml::node* n = t.get("with_position")) g.with_position = get_bool(*n, key("with_position"));
     if (const toml::node* n = t.get("seed")) g.seed = static_cast<std::uint64_t>(get_int(*n, key("seed"), 0, kMaxI64));
+    if (const toml::node* n = t.get("phase")) g.phase = get_float(*n, key("phase"), FloatRange{0.0, false, 1.0, true});
     return rate;
   }
 

@@ -59,6 +59,7 @@ MadeDriver make_synthetic(const StreamConfig& stream) {
   o.rotation_noise = sc.rotation_noise;
   o.with_position = sc.with_position;
   o.seed = sc.seed;
+  o.phase = sc.phase;
   o.stream_id = stream.id;
   MadeDriver made;
   try {

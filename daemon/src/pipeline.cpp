@@ -1,6 +1,10 @@
 #include "posefair/daemon/pipeline.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <chrono>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <stdexcept>
@@ -117,11 +121,23 @@ void Pipeline::wake_publisher() {
 
 void Pipeline::poke_engine() { wake_engine(); }
 
-void Pipeline::start() {
-  if (started_) return;
+std::vector<std::string> Pipeline::start() {
+  std::vector<std::string> problems;
+  if (started_) return problems;
   started_ = true;
   engine_thread_ = std::thread([this] { engine_loop(); });
   publisher_thread_ = std::thread([this] { publisher_loop(); });
+  if (const int prio = config_.daemon.realtime_priority; prio > 0) {
+    sched_param sp{};
+    sp.sched_priority = prio;
+    for (std::thread* t : {&engine_thread_, &publisher_thread_}) {
+      if (const int rc = ::pthread_setschedparam(t->native_handle(), SCHED_FIFO, &sp); rc != 0) {
+        problems.push_back("realtime_priority " + std::to_string(prio) + " refused (" + std::strerror(rc) +
+                           "): the engine runs with normal scheduling");
+        break;
+      }
+    }
+  }
   if (config_.recorder.enabled) recorder_thread_ = std::thread([this] { recorder_loop(); });
   drivers_running_.store(static_cast<int>(streams_.size()), std::memory_order_release);
   for (auto& sp : streams_) {
@@ -135,6 +151,7 @@ void Pipeline::start() {
       wake_engine();
     });
   }
+  return problems;
 }
 
 bool Pipeline::sources_ended() const { return started_ && drivers_running_.load(std::memory_order_acquire) == 0; }

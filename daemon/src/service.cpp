@@ -103,7 +103,7 @@ class Service {
     }
     setup_logging(config.logging, options_);
     session_ = config.daemon.session_id ? *config.daemon.session_id : random_session();
-    if (int rc = build(config, session_, {}, false, pipeline_); rc != kExitOk) return rc;
+    if (int rc = build(config, session_, {}, options_.check_only, pipeline_); rc != kExitOk) return rc;
     for (const std::string& w : pipeline_->warnings()) spdlog::warn("{}", w);
     if (options_.check_only) {
       std::printf("%s: ok (%zu streams, %zu outputs%s)\n", options_.config.c_str(), config.streams.size(),
@@ -111,7 +111,7 @@ class Service {
       pipeline_.reset();
       return kExitOk;
     }
-    pipeline_->start();
+    for (const std::string& w : pipeline_->start()) spdlog::warn("{}", w);
     spdlog::info("started: {} streams, {} outputs, session {:08x}, config {}", config.streams.size(),
                  config.outputs.size(), session_, options_.config.string());
     mark_interval();
@@ -213,7 +213,7 @@ class Service {
     if (carry) next->adopt_recorder(pipeline_->release_recorder());
     next->continue_sequences(pipeline_->next_sequences());
     pipeline_ = std::move(next);
-    pipeline_->start();
+    for (const std::string& w : pipeline_->start()) spdlog::warn("{}", w);
     mark_interval();
     last_log_ = Clock::now();
     last_log_stats_ = pipeline_->stats();

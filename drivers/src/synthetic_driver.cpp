@@ -1,7 +1,10 @@
 #include "posefair/drivers/synthetic_driver.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
 #include <cstdio>
 #include <stdexcept>
 #include <vector>
@@ -20,6 +23,8 @@ SyntheticDriver::SyntheticDriver(const SyntheticOptions& o) {
   if (!std::isfinite(o.duration) || o.duration < 0.0) throw std::invalid_argument("synthetic driver: duration must be finite and >= 0");
   if (!std::isfinite(o.rotation_noise) || o.rotation_noise < 0.0)
     throw std::invalid_argument("synthetic driver: rotation_noise must be finite and >= 0");
+  if (!(o.phase >= 0.0 && o.phase < 1.0)) throw std::invalid_argument("synthetic driver: phase must be in [0, 1)");
+  start_delay_ = o.as_fast_as_possible ? 0.0 : o.phase / o.rate_hz;
 
   // A finite duration is split into equal blocks of at most 10 s, so the rounds end on it.
   const double rounds = o.duration > 0.0 ? std::ceil(o.duration / kMaxBlockSeconds) : 0.0;
@@ -56,6 +61,17 @@ SyntheticDriver::SyntheticDriver(const SyntheticOptions& o) {
   std::snprintf(name, sizeof name, "synthetic:%gHz", o.rate_hz);
   name_ = name;
   replay_ = std::make_unique<ReplayDriver>(std::move(samples), ro, name_);
+}
+
+void SyntheticDriver::run(std::stop_token stop, SampleSink& sink) {
+  if (start_delay_ > 0.0) {
+    std::mutex mutex;
+    std::condition_variable_any wake;  // nobody notifies it: it wakes at the deadline or on stop
+    std::unique_lock lock(mutex);
+    wake.wait_for(lock, stop, std::chrono::duration<double>(start_delay_), [] { return false; });
+    if (stop.stop_requested()) return;
+  }
+  replay_->run(stop, sink);
 }
 
 }  // namespace posefair::drivers

@@ -56,6 +56,10 @@ struct DaemonSettings {
   bool exit_when_sources_end = false;
   // Fixed session id for the wire protocol; unset = random at start (the normal case).
   std::optional<std::uint32_t> session_id;
+  // SCHED_FIFO priority (1..99) for the engine and publisher threads, so samples are faired
+  // and sent ahead of other work; 0 = normal scheduling. Needs CAP_SYS_NICE or an RLIMIT_RTPRIO
+  // at least this high (the unit sets LimitRTPRIO); refused, it is logged and the daemon runs on.
+  int realtime_priority = 0;
 };
 
 // [stream.driver] with type = "replay": the simulated device backend.
@@ -75,6 +79,7 @@ struct SyntheticSourceConfig {
   double rotation_noise = 0.01;  // rad (dist on S³)
   bool with_position = false;
   std::uint64_t seed = 1;
+  double phase = 0.0;  // [0, 1): the first sample comes this fraction of a period after start
 };
 
 enum class DriverType { Replay, Synthetic };

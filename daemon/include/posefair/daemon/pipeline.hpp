@@ -43,8 +43,8 @@ class Pipeline {
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
 
-  // Starts the threads (once).
-  void start();
+  // Starts the threads (once). Returns problems worth a warning (real-time priority refused).
+  std::vector<std::string> start();
   // Stops the drivers, then drains: every sample already handed over is faired, every window
   // flushed, every pose sent, every recorded sample written and the recording synced and closed
   // (unless keep_recorder). Idempotent.

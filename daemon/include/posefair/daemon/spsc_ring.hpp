@@ -29,7 +29,8 @@
 //   would make the writer's earlier "2j+1" store visible to the s2 load). Otherwise item r is
 //   gone (overwritten before or during the read): the consumer counts it as dropped and moves
 //   on, to r+1 or straight to head-capacity, the oldest item that can still be intact
-//   (every item below it has been overwritten by a completed push).
+//   (the slot of every item below it has been claimed by a later push: the head is published
+//   after a push's "2j+1" and words, before its "2j+2").
 // - Each item number is thus classified exactly once by the consumer (popped or dropped);
 //   items the consumer has not looked at yet are either still in the ring or already
 //   overwritten, which dropped_oldest() infers from the indices (head - tail - capacity). At
@@ -38,8 +39,9 @@
 // when the ring looks full) and never overwrites an unread slot, so the consumer never laps.
 //
 // Counters and size_approx() may be read from any thread. While both ends run, each is a
-// recent value (they are separate atomics, read one after the other); once both ends are quiet
-// (e.g. after joining them) all are exact.
+// recent value (they are separate atomics, read one after the other), but no item is ever
+// counted twice: popped() + dropped() + size_approx() <= pushed() + dropped_newest() when read
+// in that order. Once both ends are quiet (e.g. after joining them) all are exact.
 //
 // T must be trivially copyable (items are copied as bytes). posefair::Sample and FairedPose
 // are NOT (Eigen's fixed-size types declare copy constructors): carry flattened records
@@ -85,9 +87,10 @@ class SpscRing {
       }
     }
     Slot& slot = slots_[h & mask_];
-    // Release on every store keeps the order odd sequence -> words -> even sequence -> head
-    // (plain moves on x86-64). Word by word straight from the item: no staging buffer, whose
-    // wide copy would stall store-to-load forwarding.
+    // Release on every store keeps the order odd sequence -> words -> head -> even sequence
+    // (plain moves on x86-64). The head goes before the item is complete so that a consumer
+    // (or reader of the counters) never sees the tail ahead of the head. Word by word straight
+    // from the item: no staging buffer, whose wide copy would stall store-to-load forwarding.
     slot.seq.store(2 * h + 1, std::memory_order_release);
     const auto* src = reinterpret_cast<const unsigned char*>(&item);
     for (std::size_t k = 0; k < kFullWords; ++k) {
@@ -100,8 +103,8 @@ class SpscRing {
       std::memcpy(&w, src + 8 * kFullWords, sizeof(T) - 8 * kFullWords);
       slot.words[kFullWords].store(w, std::memory_order_release);
     }
-    slot.seq.store(2 * h + 2, std::memory_order_release);
     head_.store(h + 1, std::memory_order_release);
+    slot.seq.store(2 * h + 2, std::memory_order_release);
     return true;
   }
 
@@ -111,14 +114,14 @@ class SpscRing {
   // it was copying (DropOldest only): then it holds that discarded, torn copy. Treat it as
   // unspecified.
   bool pop(T& out) noexcept {
-    const std::uint64_t start = tail_.load(std::memory_order_relaxed);  // written only here
-    std::uint64_t r = start;
+    std::uint64_t r = tail_.load(std::memory_order_relaxed);  // written only here
+    std::uint64_t skipped = 0;
     for (;;) {
       Slot& slot = slots_[r & mask_];
       const std::uint64_t complete = 2 * r + 2;
       const std::uint64_t s1 = slot.seq.load(std::memory_order_acquire);
       if (s1 < complete) {  // item r not (fully) written yet
-        if (r != start) tail_.store(r, std::memory_order_release);
+        if (skipped != 0) publish_consumer(r, false, skipped);
         return false;
       }
       if (s1 == complete) {
@@ -133,18 +136,18 @@ class SpscRing {
           std::memcpy(dst + 8 * kFullWords, &w, sizeof(T) - 8 * kFullWords);
         }
         if (slot.seq.load(std::memory_order_relaxed) == complete) {
-          popped_.store(popped_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-          tail_.store(r + 1, std::memory_order_release);
+          publish_consumer(r + 1, true, skipped);
           return true;
         }
       }
       // Item r was overwritten (s1 shows a later item, or s2 changed during the copy). Items
-      // below head - capacity are certainly overwritten too (their successors' pushes are
-      // complete); item head - capacity may still be intact.
+      // below head - capacity are certainly lost too (the pushes into their slots have begun:
+      // each stored its odd sequence before the head we read); item head - capacity may still
+      // be intact.
       const std::uint64_t h = head_.load(std::memory_order_acquire);
       std::uint64_t next = r + 1;
       if (h > capacity_ && h - capacity_ > next) next = h - capacity_;
-      skipped_.store(skipped_.load(std::memory_order_relaxed) + (next - r), std::memory_order_relaxed);
+      skipped += next - r;
       r = next;
     }
   }
@@ -163,10 +166,13 @@ class SpscRing {
   // push() calls that stored their item (all of them under DropOldest). Any thread.
   std::uint64_t pushed() const noexcept { return head_.load(std::memory_order_acquire); }
   // pop() calls that returned an item. Any thread.
-  std::uint64_t popped() const noexcept { return popped_.load(std::memory_order_relaxed); }
+  std::uint64_t popped() const noexcept { return popped_.load(std::memory_order_acquire); }
   // Items lost because the ring was full: overwritten unread (DropOldest; including overwrites
   // the consumer has not reached yet) ...
   std::uint64_t dropped_oldest() const noexcept {
+    if (policy_ == OverflowPolicy::DropNewest) return 0;
+    // skipped_ first: it is stored after tail_, so no item is counted both as skipped and as
+    // beyond the tail (a reader racing the consumer may undercount for a moment, never over).
     const std::uint64_t s = skipped_.load(std::memory_order_acquire);
     const std::uint64_t t = tail_.load(std::memory_order_acquire);
     const std::uint64_t h = head_.load(std::memory_order_acquire);
@@ -184,6 +190,14 @@ class SpscRing {
     std::atomic<std::uint64_t> seq{0};  // 2i+1: item i being written; 2i+2: item i complete
     std::atomic<std::uint64_t> words[kWords];
   };
+
+  // The consumer's state after a pop: the tail first, then the counters (release), so a
+  // reader that sees a counter's new value also sees the tail that goes with it.
+  void publish_consumer(std::uint64_t tail, bool popped_one, std::uint64_t skipped) noexcept {
+    tail_.store(tail, std::memory_order_release);
+    if (popped_one) popped_.store(popped_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+    if (skipped != 0) skipped_.store(skipped_.load(std::memory_order_relaxed) + skipped, std::memory_order_release);
+  }
 
   static std::unique_ptr<Slot[]> make_slots(std::size_t capacity) {
     if (capacity == 0 || capacity > kMaxCapacity || !std::has_single_bit(capacity))

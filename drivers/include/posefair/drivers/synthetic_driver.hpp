@@ -22,6 +22,7 @@ struct SyntheticOptions {
   bool with_position = false;    // positions in metres, noise 1 mm
   std::uint64_t seed = 1;
   std::uint32_t stream_id = 0;
+  double phase = 0.0;  // [0, 1): first sample this fraction of a period after run() starts
   // Deliver as fast as possible instead of at rate_hz (tests).
   bool as_fast_as_possible = false;
 };
@@ -32,12 +33,13 @@ class SyntheticDriver final : public Driver {
   // non-finite duration or noise.
   explicit SyntheticDriver(const SyntheticOptions& options);
   std::string_view name() const override { return name_; }
-  void run(std::stop_token stop, SampleSink& sink) override { replay_->run(stop, sink); }
+  void run(std::stop_token stop, SampleSink& sink) override;
   std::uint64_t delivered() const { return replay_->delivered(); }
   std::uint64_t dropped() const { return replay_->dropped(); }
 
  private:
   std::string name_;
+  double start_delay_ = 0.0;  // s
   std::unique_ptr<ReplayDriver> replay_;
 };
 
