@@ -3,6 +3,8 @@
 #include <pthread.h>
 #include <sched.h>
 
+#include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cstring>
 #include <ctime>
@@ -46,8 +48,11 @@ struct Pipeline::Stream final : drivers::SampleSink {
         source(std::move(made.source)),
         window(c.engine),
         ring(c.ring_capacity, c.overflow),
-        // The publisher ring drops the oldest pose: a subscriber wants the newest.
-        pose_ring(c.ring_capacity, OverflowPolicy::DropOldest),
+        // The publisher ring drops the oldest pose (a subscriber wants the newest). It holds at
+        // least two engine batches, so a publisher that is merely waiting to be scheduled never
+        // loses a pose however small the input ring is.
+        pose_ring(std::max<std::size_t>(c.ring_capacity, std::bit_ceil(static_cast<std::size_t>(2 * kPopBudget + c.engine.lag + 1))),
+                  OverflowPolicy::DropOldest),
         outputs(static_cast<std::size_t>(window.max_outputs_per_push())) {
     if (record) record_ring = std::make_unique<SpscRing<RingSample>>(owner.config_.recorder.ring_capacity, OverflowPolicy::DropNewest);
   }
@@ -110,13 +115,11 @@ Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
 Pipeline::~Pipeline() { stop(); }
 
 void Pipeline::wake_engine() {
-  engine_wake_.fetch_add(1, std::memory_order_release);
-  engine_wake_.notify_one();
+  engine_wake_.notify();
 }
 
 void Pipeline::wake_publisher() {
-  publisher_wake_.fetch_add(1, std::memory_order_release);
-  publisher_wake_.notify_one();
+  publisher_wake_.notify();
 }
 
 void Pipeline::poke_engine() { wake_engine(); }
@@ -183,18 +186,23 @@ void Pipeline::stop(bool keep_recorder) {
 
 void Pipeline::engine_loop() {
   for (;;) {
-    const std::uint32_t seen = engine_wake_.load(std::memory_order_acquire);
+    const std::uint32_t seen = engine_wake_.prepare();
     heartbeat_.fetch_add(1, std::memory_order_relaxed);
     bool any = false;
     for (auto& sp : streams_) {
       Stream& s = *sp;
       RingSample r;
+      bool emitted = false;
       for (int budget = kPopBudget; budget > 0 && s.ring.pop(r); --budget) {
         any = true;
         if (hooks_.before_engine_sample) hooks_.before_engine_sample(s.config.id);
         const int k = s.window.push(unpack(r), s.outputs);
         for (int j = 0; j < k; ++j) s.pose_ring.push(pack(s.outputs[static_cast<std::size_t>(j)], s.index, r.enqueued_ns));
+        emitted = emitted || k > 0;
       }
+      // Wake the publisher after each stream's batch (not after the whole pass), so it works
+      // alongside the engine instead of after it.
+      if (emitted) wake_publisher();
       // The driver has ended and everything it delivered is in: hand over the lagged tail.
       if (!s.flushed && s.driver_done.load(std::memory_order_acquire) && s.ring.size_approx() == 0) {
         const int k = s.window.flush(s.outputs);
@@ -216,13 +224,13 @@ void Pipeline::engine_loop() {
       continue;
     }
     if (engine_stop_.load(std::memory_order_acquire)) return;
-    engine_wake_.wait(seen, std::memory_order_acquire);
+    engine_wake_.wait(seen);
   }
 }
 
 void Pipeline::publisher_loop() {
   for (;;) {
-    const std::uint32_t seen = publisher_wake_.load(std::memory_order_acquire);
+    const std::uint32_t seen = publisher_wake_.prepare();
     bool any = false;
     for (auto& sp : streams_) {
       Stream& s = *sp;
@@ -238,7 +246,7 @@ void Pipeline::publisher_loop() {
     }
     if (any) continue;
     if (publisher_stop_.load(std::memory_order_acquire)) return;
-    publisher_wake_.wait(seen, std::memory_order_acquire);
+    publisher_wake_.wait(seen);
   }
 }
 

@@ -194,8 +194,13 @@ class Service {
     }
     const RecorderConfig& old_rec = pipeline_->config().recorder;
     const bool carry = next_config.recorder.enabled && old_rec.enabled && next_config.recorder.path == old_rec.path;
+    // A reload restarts every window and every source's time base (a replay starts again), so
+    // by default it starts a new session: subscribers see the sequence restart (docs/protocol.md).
+    // A fixed session_id keeps the session and continues each stream's sequence instead.
+    const bool keep_session = next_config.daemon.session_id.has_value();
+    const std::uint32_t session = keep_session ? *next_config.daemon.session_id : random_session();
     std::unique_ptr<Pipeline> next;
-    if (build(next_config, session_, {}, carry, next) != kExitOk) {
+    if (build(next_config, session, {}, carry, next) != kExitOk) {
       spdlog::error("reload refused, keeping the running configuration");
       notify("READY=1");
       return;
@@ -211,13 +216,15 @@ class Service {
     pipeline_->stop(carry);
     log_counters(*pipeline_, {}, 0.0);
     if (carry) next->adopt_recorder(pipeline_->release_recorder());
-    next->continue_sequences(pipeline_->next_sequences());
+    if (keep_session && session == session_) next->continue_sequences(pipeline_->next_sequences());
+    session_ = session;
     pipeline_ = std::move(next);
     for (const std::string& w : pipeline_->start()) spdlog::warn("{}", w);
     mark_interval();
     last_log_ = Clock::now();
     last_log_stats_ = pipeline_->stats();
-    spdlog::info("reloaded: {} streams, {} outputs", pipeline_->config().streams.size(), pipeline_->config().outputs.size());
+    spdlog::info("reloaded: {} streams, {} outputs, session {:08x}", pipeline_->config().streams.size(),
+                 pipeline_->config().outputs.size(), session_);
     notify("READY=1");
   }
 

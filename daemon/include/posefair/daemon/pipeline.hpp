@@ -5,7 +5,7 @@
 //   stream) ─► publisher thread ─► UDP;   driver thread ─► ring (per stream) ─► recorder thread
 //
 // The engine thread owns every FairingWindow and never blocks, allocates or logs; it sleeps on
-// a futex (std::atomic::wait) only when every ring is empty. The publisher is fed through
+// a futex (WakeSignal) only when every ring is empty. The publisher is fed through
 // rings too, so a slow network cannot stall the engine. Each ring's overflow is counted.
 // A SIGHUP reload builds a new Pipeline from the new config while the old one runs, then stops
 // the old one (drained) and starts the new one: the swap is whole.
@@ -20,6 +20,7 @@
 
 #include "posefair/daemon/config.hpp"
 #include "posefair/daemon/stream_counters.hpp"
+#include "posefair/daemon/wake_signal.hpp"
 #include "posefair/drivers/sample_log.hpp"
 
 namespace posefair::daemon {
@@ -91,8 +92,8 @@ class Pipeline {
   std::unique_ptr<drivers::SampleLogWriter> writer_;
   std::map<std::uint32_t, std::uint64_t> final_sequences_;
 
-  std::atomic<std::uint32_t> engine_wake_{0};
-  std::atomic<std::uint32_t> publisher_wake_{0};
+  WakeSignal engine_wake_;
+  WakeSignal publisher_wake_;
   std::atomic<std::uint64_t> heartbeat_{0};
   std::atomic<bool> engine_stop_{false};
   std::atomic<bool> publisher_stop_{false};

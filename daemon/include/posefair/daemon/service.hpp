@@ -4,8 +4,9 @@
 //   SIGTERM, SIGINT  drain (every sample handed over is faired and sent, the recording synced)
 //                    and exit 0;
 //   SIGHUP           reload: parse and check the file again off the real-time path; a good one
-//                    replaces the running pipeline whole (wire sequence numbers and session
-//                    continue), a bad one is logged and the running one kept;
+//                    replaces the running pipeline whole (a new session, unless session_id is
+//                    fixed: then the session stays and sequences continue), a bad one is logged
+//                    and the running one kept;
 //   SIGUSR1          log every stream's counters now.
 // docs/operations.md describes it for operators.
 #include <filesystem>

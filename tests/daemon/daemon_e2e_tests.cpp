@@ -1,0 +1,744 @@
+// posefaird end to end: the real binaries (build/daemon/posefaird, build/tools/posefair) as
+// child processes, UDP on 127.0.0.1 only. Every wait has a deadline and every child still
+// running at the end of a test is killed (Subprocess). Ports are free ones the kernel chose
+// (a socket bound to port 0, by the test or by `posefair sub --listen 127.0.0.1:0`).
+//
+//   FairVsDaemon.*            `posefair fair --causal` and posefaird give the same poses, bit for bit
+//   DaemonSignals.Sighup*     a bad config is refused and the running one kept; a good one is
+//                             taken with the session and the sequence numbers continued
+//   DaemonRecording.*         SIGTERM while recording, the recording replayed; a truncated one
+//   DaemonConfigErrors.*      malformed configs exit 78 with FILE:LINE: and the key
+//   SubIdle.*                 `posefair sub --idle`
+#include <signal.h>
+#include <sys/socket.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <map>
+#include <vector>
+
+#include "../protocol/subprocess.hpp"
+#include "../support/test_files.hpp"
+#include "posefair/daemon/udp_socket.hpp"
+#include "posefair/daemon/wire_protocol.hpp"
+#include "posefair/drivers/pose_file.hpp"
+#include "posefair/drivers/sample_log.hpp"
+
+namespace posefair::testing {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+const std::string kPosefaird = POSEFAIR_BINARY_DIR "/daemon/posefaird";
+const std::string kPosefair = POSEFAIR_BINARY_DIR "/tools/posefair";
+const fs::path kDemoCsv = fs::path(POSEFAIR_SOURCE_DIR) / "data/demo/broad-07-excerpt.csv";
+constexpr std::size_t kDemoSamples = 2000;
+constexpr int kExitConfig = 78;
+
+// ---------------------------------------------------------------------------------------------
+// Helpers
+
+void write_text(const fs::path& p, const std::string& text) {
+  // Written whole under another name, then renamed over: the daemon never sees half a file.
+  const fs::path tmp = p.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << text;
+    out.flush();
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, p);
+}
+
+std::vector<std::string> split(const std::string& text, char sep) {
+  std::vector<std::string> parts;
+  std::string cur;
+  std::istringstream in(text);
+  while (std::getline(in, cur, sep)) parts.push_back(cur);
+  return parts;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  for (std::string& l : split(text, '\n'))
+    if (!l.empty()) out.push_back(std::move(l));
+  return out;
+}
+
+std::size_t count_of(const std::string& text, const std::string& needle) {
+  std::size_t n = 0;
+  for (auto at = text.find(needle); at != std::string::npos; at = text.find(needle, at + needle.size())) ++n;
+  return n;
+}
+
+// strtod is correctly rounded: the shortest / %.17g text of a double reads back as that double.
+double to_double(const std::string& s) {
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || end != s.c_str() + s.size()) throw std::runtime_error("not a number: '" + s + "'");
+  return v;
+}
+
+std::uint64_t to_u64(const std::string& s) { return std::stoull(s); }
+
+bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
+  const auto deadline = Clock::now() + timeout;
+  while (!done()) {
+    if (Clock::now() > deadline) return false;
+    std::this_thread::sleep_for(10ms);
+  }
+  return true;
+}
+
+// Waits (bounded) until a child's stderr holds `needle` `occurrences` times; false on timeout
+// or as soon as the child has exited without it.
+bool wait_for_log_or_exit(Subprocess& p, const std::string& needle, std::chrono::milliseconds timeout,
+                          std::size_t occurrences = 1) {
+  const auto deadline = Clock::now() + timeout;
+  for (;;) {
+    const bool alive = p.running();  // first: if it had exited, the log read next is complete
+    if (count_of(p.err(), needle) >= occurrences) return true;
+    if (!alive || Clock::now() > deadline) return false;
+    std::this_thread::sleep_for(10ms);
+  }
+}
+
+// The daemon's counter line for one stream ("stream NAME (id N, ...): received N, dropped N
+// (ring N, publish N), rejected N, out-of-order N, emitted N, clamped N, restarts N,
+// published N, send failures N, recorded N (dropped N), latency ..."); the last one in the log.
+struct Counters {
+  std::string line;
+  std::uint64_t received = 0, dropped = 0, ring = 0, publish = 0, rejected = 0, out_of_order = 0, emitted = 0,
+                published = 0, send_failures = 0, recorded = 0, record_dropped = 0;
+};
+
+std::optional<Counters> last_counters(const std::string& log, const std::string& name, std::uint32_t id) {
+  const std::string head = "stream " + name + " (id " + std::to_string(id) + ", ";
+  std::optional<Counters> found;
+  for (const std::string& line : lines_of(log)) {
+    const auto at = line.find(head);
+    if (at == std::string::npos) continue;
+    const auto body_at = line.find("): received ", at);
+    if (body_at == std::string::npos) continue;
+    const std::string body = line.substr(body_at + 2);  // "received N, dropped ..."
+    auto field = [&body](const std::string& label) -> std::uint64_t {
+      const auto p = body.find(label);
+      if (p == std::string::npos) throw std::runtime_error("no '" + label + "' in " + body);
+      return std::stoull(body.substr(p + label.size()));
+    };
+    Counters c;
+    c.line = line;
+    c.received = field("received ");
+    c.dropped = field(", dropped ");
+    c.ring = field("(ring ");
+    c.publish = field(", publish ");
+    c.rejected = field(", rejected ");
+    c.out_of_order = field(", out-of-order ");
+    c.emitted = field(", emitted ");
+    c.published = field(", published ");
+    c.send_failures = field(", send failures ");
+    c.recorded = field(", recorded ");
+    c.record_dropped = field("(dropped ");
+    found = c;
+  }
+  return found;
+}
+
+std::vector<std::string> daemon_args(const fs::path& config) {
+  return {kPosefaird, "-c", config.string(), "--log-target", "stderr"};
+}
+
+// Every datagram reaching a socket bound to 127.0.0.1:0, received on a thread of its own.
+class Collector {
+ public:
+  struct Got {
+    daemon::PoseMessage m;
+    Clock::time_point at;
+  };
+
+  Collector() {
+    daemon::ReceiveOptions ro;
+    ro.receive_buffer_bytes = 4 << 20;
+    socket_ = daemon::UdpSocket::bind(*daemon::Endpoint::parse("127.0.0.1:0"), ro);
+    thread_ = std::thread([this] { loop(); });
+  }
+  ~Collector() {
+    stop_.store(true);
+    thread_.join();
+  }
+  Collector(const Collector&) = delete;
+  Collector& operator=(const Collector&) = delete;
+
+  std::uint16_t port() const { return socket_.local_endpoint().port(); }
+  std::vector<Got> all() const {
+    std::lock_guard lock(mutex_);
+    return got_;
+  }
+  std::size_t malformed() const {
+    std::lock_guard lock(mutex_);
+    return malformed_;
+  }
+  std::size_t count(std::uint32_t stream) const {
+    std::lock_guard lock(mutex_);
+    return static_cast<std::size_t>(
+        std::count_if(got_.begin(), got_.end(), [&](const Got& g) { return g.m.stream == stream; }));
+  }
+
+ private:
+  void loop() {
+    std::vector<std::uint8_t> buffer(daemon::kMaxDatagramSize + 1);
+    while (!stop_.load()) {
+      const auto d = socket_.receive(buffer, 20ms);
+      if (!d) continue;
+      const auto r = d->truncated ? daemon::rejected(daemon::DecodeError::kOversized, daemon::WireEncoding::kBinary)
+                                  : daemon::decode_datagram(std::span<const std::uint8_t>(buffer.data(), d->size));
+      std::lock_guard lock(mutex_);
+      if (r.ok())
+        got_.push_back(Got{r.message, Clock::now()});
+      else
+        ++malformed_;
+    }
+  }
+
+  daemon::UdpSocket socket_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  mutable std::mutex mutex_;
+  std::vector<Got> got_;
+  std::size_t malformed_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+// 1. `posefair fair --causal` and posefaird agree bit for bit
+
+// A CSV table: header names and rows of fields (no quoting: neither file needs it).
+struct Table {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  std::size_t column(const std::string& name) const {
+    const auto it = std::find(header.begin(), header.end(), name);
+    if (it == header.end()) throw std::runtime_error("no column " + name);
+    return static_cast<std::size_t>(it - header.begin());
+  }
+};
+
+Table read_table(const std::string& text) {
+  Table t;
+  const auto lines = lines_of(text);
+  if (lines.empty()) return t;
+  t.header = split(lines[0], ',');
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    auto fields = split(lines[i], ',');
+    if (!lines[i].empty() && lines[i].back() == ',') fields.push_back("");  // getline drops a trailing empty field
+    t.rows.push_back(std::move(fields));
+  }
+  return t;
+}
+
+struct EngineCase {
+  const char* name;
+  std::vector<std::string> fair_args;  // after --causal
+  std::string toml;                    // the same settings as [stream.engine] keys
+};
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+void run_fair_vs_daemon(const EngineCase& c) {
+  ScratchDir dir("posefair-e2e-");
+  const fs::path fair_csv = dir / "fair.csv";
+
+  // posefair fair --causal over the demo recording.
+  std::vector<std::string> fair = {kPosefair, "fair", kDemoCsv.string(), "-o", fair_csv.string(), "--causal"};
+  fair.insert(fair.end(), c.fair_args.begin(), c.fair_args.end());
+  Subprocess f(fair, dir / "fair.out", dir / "fair.err");
+  ASSERT_EQ(f.wait(60s), 0) << f.out() << f.err();
+  // Read back as the daemon's replay driver reads a pose file: a value the fair tool left
+  // unchanged keeps the file's text, which stands for the (renormalised) value read, and
+  // everything else is written as the shortest text of its double, so this is exact.
+  const drivers::PoseFile expected_file = drivers::read_pose_file(fair_csv, {});
+  const PoseSequence& expected = expected_file.poses();
+  ASSERT_EQ(expected.size(), kDemoSamples) << f.out();
+  ASSERT_TRUE(expected.has_position());
+  // The input as the daemon reads it: a pose equal to its measurement is no evidence of fairing.
+  const PoseSequence input = drivers::read_pose_file(kDemoCsv, {}).poses();
+  ASSERT_EQ(input.size(), kDemoSamples);
+
+  // posefair sub on a free port, then posefaird replaying the same file with the same engine.
+  Subprocess sub({kPosefair, "sub", "--listen", "127.0.0.1:0", "--format", "csv", "--idle", "2", "--duration", "60"},
+                 dir / "sub.out", dir / "sub.err");
+  const auto port = sub.wait_for_listening_port(20s);
+  ASSERT_TRUE(port) << sub.err();
+
+  const fs::path config = dir / "posefaird.toml";
+  write_text(config, std::string("[daemon]\nexit_when_sources_end = true\nsession_id = 3054\n\n") +
+                         "[logging]\nstatus_interval = 0\n\n"
+                         "[[stream]]\nid = 1\nname = \"broad07\"\nring_capacity = 4096\n"
+                         "[stream.driver]\ntype = \"replay\"\npath = \"" +
+                         kDemoCsv.string() +
+                         "\"\ntiming = \"original\"\nspeed = 10.0\n"
+                         "[stream.engine]\n" +
+                         c.toml + "\n[[output]]\nencoding = \"binary\"\ndestinations = [\"127.0.0.1:" +
+                         std::to_string(*port) + "\"]\n");
+  Subprocess d(daemon_args(config), dir / "d.out", dir / "d.err");
+  const auto drc = d.wait(60s);
+  ASSERT_EQ(drc, 0) << d.err();
+  EXPECT_NE(d.err().find("every source has ended"), std::string::npos) << d.err();
+  const auto counters = last_counters(d.err(), "broad07", 1);
+  ASSERT_TRUE(counters) << d.err();
+  EXPECT_EQ(counters->received, kDemoSamples) << counters->line;
+  EXPECT_EQ(counters->dropped, 0u) << counters->line;
+  EXPECT_EQ(counters->emitted, kDemoSamples) << counters->line;
+  EXPECT_EQ(counters->published, kDemoSamples) << counters->line;
+  EXPECT_EQ(counters->send_failures, 0u) << counters->line;
+
+  // sub exits by itself 2 s after the last pose.
+  ASSERT_EQ(sub.wait(30s), 0) << sub.err();
+  const Table got = read_table(sub.out());
+  ASSERT_EQ(got.header.size(), 17u) << sub.out().substr(0, 200);
+  EXPECT_NE(sub.err().find("stats: received 2000, lost 0, reordered 0, duplicates 0, malformed 0"), std::string::npos)
+      << sub.err();
+  ASSERT_EQ(got.rows.size(), kDemoSamples) << sub.err();
+  const std::size_t gq[4] = {got.column("qw"), got.column("qx"), got.column("qy"), got.column("qz")};
+  const std::size_t gp[3] = {got.column("px"), got.column("py"), got.column("pz")};
+
+  std::size_t value_mismatches = 0, sign_flips = 0, reported = 0, faired = 0;
+  for (std::size_t i = 0; i < got.rows.size(); ++i) {
+    const auto& g = got.rows[i];
+    ASSERT_EQ(g.size(), 17u) << "sub row " << i;
+    ASSERT_EQ(to_u64(g[got.column("session")]), 3054u);
+    ASSERT_EQ(to_u64(g[got.column("stream")]), 1u);
+    ASSERT_EQ(to_u64(g[got.column("seq")]), i) << "poses arrive in order, none lost";
+    // The same sample: its time, exactly.
+    const double te = expected.time[i], tg = to_double(g[got.column("t")]);
+    ASSERT_TRUE(te == tg && same_bits(te, tg)) << "pose " << i << ": time " << g[got.column("t")] << " vs " << te;
+
+    const Quat& q = expected.orientation[i];
+    const Vec3& p = expected.position[i];
+    const double qe[4] = {q.w(), q.x(), q.y(), q.z()}, pe[3] = {p.x(), p.y(), p.z()};
+    double qg[4], pg[3];
+    for (int k = 0; k < 4; ++k) qg[k] = to_double(g[gq[k]]);
+    for (int k = 0; k < 3; ++k) pg[k] = to_double(g[gp[k]]);
+    bool equal = true, negated = true, positions_equal = true;
+    for (int k = 0; k < 4; ++k) {
+      equal = equal && qe[k] == qg[k] && same_bits(qe[k], qg[k]);
+      negated = negated && same_bits(-qe[k], qg[k]);
+    }
+    for (int k = 0; k < 3; ++k) positions_equal = positions_equal && pe[k] == pg[k] && same_bits(pe[k], pg[k]);
+    if (input.orientation[i].coeffs() != q.coeffs()) ++faired;
+    if (equal && positions_equal) continue;
+    if (negated && positions_equal)
+      ++sign_flips;
+    else
+      ++value_mismatches;
+    if (reported++ < 5) {
+      char text[512];
+      std::snprintf(text, sizeof text,
+                    "pose %zu%s: daemon q %.17g %.17g %.17g %.17g p %.17g %.17g %.17g, fair q %.17g %.17g %.17g %.17g "
+                    "p %.17g %.17g %.17g",
+                    i, negated && positions_equal ? " (quaternion sign differs)" : "", qg[0], qg[1], qg[2], qg[3],
+                    pg[0], pg[1], pg[2], qe[0], qe[1], qe[2], qe[3], pe[0], pe[1], pe[2]);
+      ADD_FAILURE() << text;
+    }
+  }
+  // Most poses are moved by the fairing (else this would only compare the input with itself).
+  EXPECT_GT(faired, kDemoSamples / 2);
+  EXPECT_EQ(value_mismatches, 0u) << "poses whose values differ from posefair fair --causal";
+  EXPECT_EQ(sign_flips, 0u) << "poses equal up to the quaternion's sign only (fair keeps each input sample's sign, "
+                               "the daemon sends the engine's hemisphere-continuous output)";
+}
+
+TEST(FairVsDaemon, LinearSolverWithLagIsBitIdentical) {
+  run_fair_vs_daemon({"linear, order 3, window 32, lag 4",
+                      {"--order", "3", "--window", "32", "--lag", "4", "--smoothing", "2000", "--continuity", "0.5",
+                       "--eps-r", "0.05", "--eps-t", "0.005", "--quiet"},
+                      "order = 3\nwindow = 32\nlag = 4\nsmoothing = 2000.0\ncontinuity = 0.5\n"
+                      "epsilon_r = 0.05\nepsilon_t = 0.005\n"});
+}
+
+TEST(FairVsDaemon, GaussNewtonWithoutLagIsBitIdentical) {
+  run_fair_vs_daemon({"gauss-newton, order 2, window 24, lag 0",
+                      {"--order", "2", "--window", "24", "--lag", "0", "--solver", "gauss-newton",
+                       "--window-iterations", "2", "--smoothing", "500", "--continuity", "0.25", "--eps-r", "0.05",
+                       "--eps-t", "0.005", "--quiet"},
+                      "order = 2\nwindow = 24\nlag = 0\nsolver = \"gauss-newton\"\niterations = 2\n"
+                      "smoothing = 500.0\ncontinuity = 0.25\nepsilon_r = 0.05\nepsilon_t = 0.005\n"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// 3. SIGHUP: a bad config is refused, a good one taken (a new session, or the same with a fixed session_id)
+
+std::string synthetic_config(std::uint16_t port, bool second_stream) {
+  std::string s =
+      "[logging]\nstatus_interval = 0\n\n"
+      "[[stream]]\nid = 1\nname = \"one\"\n"
+      "driver = { type = \"synthetic\", rate_hz = 200.0, duration = 0.0 }\n";
+  if (second_stream)
+    s += "\n[[stream]]\nid = 2\nname = \"two\"\n"
+         "driver = { type = \"synthetic\", rate_hz = 200.0, duration = 0.0, seed = 2 }\n";
+  s += "\n[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(port) + "\"]\n";
+  return s;
+}
+
+TEST(DaemonSignals, SighupRefusesABadConfigAndTakesAGoodOneInANewSession) {
+  ScratchDir dir("posefair-e2e-");
+  Collector poses;
+  const fs::path config = dir / "posefaird.toml";
+  write_text(config, synthetic_config(poses.port(), false));
+  Subprocess d(daemon_args(config), dir / "d.out", dir / "d.err");
+  ASSERT_TRUE(wait_until([&] { return poses.count(1) >= 20 || !d.running(); }, 20s)) << d.err();
+  ASSERT_TRUE(d.running()) << d.err();
+  const auto first = poses.all();
+  const std::uint32_t session = first.front().m.session;
+
+  // A bad file: refused, the running configuration kept.
+  std::string bad = synthetic_config(poses.port(), true);
+  bad += "[engine]\nwindow = \"x\"\n";
+  write_text(config, bad);
+  const std::size_t before_bad = poses.count(1);
+  d.send_signal(SIGHUP);
+  ASSERT_TRUE(wait_for_log_or_exit(d, "reload refused, keeping the running configuration", 15s)) << d.err();
+  EXPECT_NE(d.err().find("engine.window"), std::string::npos) << "the refusal names the key: " << d.err();
+  ASSERT_TRUE(wait_until([&] { return poses.count(1) >= before_bad + 40 || !d.running(); }, 20s)) << d.err();
+  ASSERT_TRUE(d.running()) << d.err();
+  EXPECT_EQ(poses.count(2), 0u) << "the refused config's stream 2 must not run";
+  EXPECT_EQ(count_of(d.err(), "reloaded:"), 0u) << d.err();
+
+  // A good file with a second stream: taken.
+  write_text(config, synthetic_config(poses.port(), true));
+  const std::size_t before_good = poses.count(1);
+  d.send_signal(SIGHUP);
+  ASSERT_TRUE(wait_for_log_or_exit(d, "reloaded: 2 streams, 1 outputs", 15s)) << d.err();
+  ASSERT_TRUE(wait_until([&] { return (poses.count(2) >= 40 && poses.count(1) >= before_good + 40) || !d.running(); },
+                         20s))
+      << d.err();
+  ASSERT_TRUE(d.running()) << d.err();
+
+  d.send_signal(SIGTERM);
+  const auto t_term = Clock::now();
+  const auto rc = d.wait(15s);
+  ASSERT_EQ(rc, 0) << d.err();
+  EXPECT_LT(Clock::now() - t_term, 5s) << "SIGTERM took too long";
+  EXPECT_NE(d.err().find("SIGTERM: draining and stopping"), std::string::npos) << d.err();
+
+  const auto all = poses.all();
+  EXPECT_EQ(poses.malformed(), 0u);
+  // The refused reload changed nothing: the first session runs until the good reload, which
+  // starts a new session (windows and sources restart, docs/operations.md). Within each
+  // session every stream's sequence starts at 0 and counts up by one per pose.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::uint64_t>> seqs;
+  std::vector<std::uint32_t> sessions;
+  for (const auto& g : all) {
+    EXPECT_TRUE(g.m.stream == 1 || g.m.stream == 2) << g.m.stream;
+    seqs[{g.m.session, g.m.stream}].push_back(g.m.sequence);
+    if (sessions.empty() || sessions.back() != g.m.session) sessions.push_back(g.m.session);
+  }
+  ASSERT_EQ(sessions.size(), 2u) << "one session before the good reload, one after";
+  EXPECT_EQ(sessions[0], session);
+  EXPECT_NE(sessions[1], session);
+  const auto& s1_before = seqs[std::make_pair(sessions[0], 1u)];
+  ASSERT_GE(s1_before.size(), before_good) << "the refused reload must not have restarted stream 1";
+  EXPECT_EQ(seqs.count(std::make_pair(sessions[0], 2u)), 0u) << "stream 2 runs only after the good reload";
+  for (const auto& [key, seq] : seqs) {
+    ASSERT_FALSE(seq.empty());
+    EXPECT_EQ(seq.front(), 0u) << "session " << key.first << " stream " << key.second;
+    std::size_t gaps = 0;
+    for (std::size_t i = 1; i < seq.size(); ++i) {
+      ASSERT_GT(seq[i], seq[i - 1]) << "session " << key.first << " stream " << key.second << " at pose " << i;
+      gaps += seq[i] != seq[i - 1] + 1;
+    }
+    // Loopback with a 4 MiB buffer at 400 poses/s loses nothing: a gap is the daemon's.
+    EXPECT_EQ(gaps, 0u) << "session " << key.first << " stream " << key.second;
+  }
+  ASSERT_GE(seqs[std::make_pair(sessions[1], 1u)].size(), 40u);
+  ASSERT_GE(seqs[std::make_pair(sessions[1], 2u)].size(), 40u);
+  // The daemon's final counters agree with what arrived after the reload.
+  const auto c1 = last_counters(d.err(), "one", 1);
+  const auto c2 = last_counters(d.err(), "two", 2);
+  ASSERT_TRUE(c1 && c2) << d.err();
+  EXPECT_EQ(c1->published, seqs[std::make_pair(sessions[1], 1u)].size()) << c1->line;
+  EXPECT_EQ(c2->published, seqs[std::make_pair(sessions[1], 2u)].size()) << c2->line;
+}
+
+TEST(DaemonSignals, SighupWithAFixedSessionIdContinuesTheSequence) {
+  ScratchDir dir("posefair-e2e-");
+  Collector poses;
+  const fs::path config = dir / "posefaird.toml";
+  const std::string text = "[daemon]\nsession_id = 4242\n" + synthetic_config(poses.port(), false);
+  write_text(config, text);
+  Subprocess d(daemon_args(config), dir / "d.out", dir / "d.err");
+  ASSERT_TRUE(wait_until([&] { return poses.count(1) >= 20 || !d.running(); }, 20s)) << d.err();
+  const std::size_t before = poses.count(1);
+  d.send_signal(SIGHUP);
+  ASSERT_TRUE(wait_for_log_or_exit(d, "reloaded:", 15s)) << d.err();
+  ASSERT_TRUE(wait_until([&] { return poses.count(1) >= before + 40 || !d.running(); }, 20s)) << d.err();
+  d.send_signal(SIGTERM);
+  ASSERT_EQ(d.wait(15s), 0) << d.err();
+  const auto all = poses.all();
+  ASSERT_GE(all.size(), before + 40);
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    EXPECT_EQ(all[i].m.session, 4242u);
+    EXPECT_EQ(all[i].m.sequence, i) << "the sequence continues across the reload without a gap or restart";
+  }
+}
+
+// docs/protocol.md: the sample time is "monotonic within a session". A reload builds new
+// drivers, and a synthetic or replay driver starts its times again from the beginning: so the
+// reload must start a new session.
+TEST(DaemonSignals, SighupKeepsEachStreamsSampleTimeMonotonicWithinTheSession) {
+  ScratchDir dir("posefair-e2e-");
+  Collector poses;
+  const fs::path config = dir / "posefaird.toml";
+  write_text(config, synthetic_config(poses.port(), false));
+  Subprocess d(daemon_args(config), dir / "d.out", dir / "d.err");
+  ASSERT_TRUE(wait_until([&] { return poses.count(1) >= 100 || !d.running(); }, 20s)) << d.err();
+  const std::size_t before = poses.count(1);
+  d.send_signal(SIGHUP);  // the same file again
+  ASSERT_TRUE(wait_for_log_or_exit(d, "reloaded:", 15s)) << d.err();
+  ASSERT_TRUE(wait_until([&] { return poses.count(1) >= before + 40 || !d.running(); }, 20s)) << d.err();
+  d.send_signal(SIGTERM);
+  ASSERT_EQ(d.wait(15s), 0) << d.err();
+  const auto all = poses.all();
+  ASSERT_FALSE(all.empty());
+  for (std::size_t i = 1; i < all.size(); ++i) {
+    if (all[i].m.session != all[i - 1].m.session) continue;
+    ASSERT_GT(all[i].m.sample_time, all[i - 1].m.sample_time)
+        << "session " << all[i].m.session << " seq " << all[i - 1].m.sequence << " -> " << all[i].m.sequence;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// 4. and 5. Recordings
+
+TEST(DaemonRecording, SigtermWhileRecordingThenReplayTheRecording) {
+  ScratchDir dir("posefair-e2e-");
+  const fs::path recording = dir / "live.pflog";
+  const fs::path config = dir / "record.toml";
+  write_text(config,
+             "[logging]\nstatus_interval = 0\n\n"
+             "[[stream]]\nid = 3\nname = \"rec\"\n"
+             "driver = { type = \"synthetic\", rate_hz = 500.0, duration = 0.0, with_position = true }\n\n"
+             "[recorder]\npath = \"live.pflog\"\nflush_interval = 0.2\n");
+  Subprocess d(daemon_args(config), dir / "d.out", dir / "d.err");
+  ASSERT_TRUE(wait_for_log_or_exit(d, "started:", 20s)) << d.err();
+  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(d.running()) << d.err();
+  d.send_signal(SIGTERM);
+  ASSERT_EQ(d.wait(20s), 0) << d.err();
+  const auto c = last_counters(d.err(), "rec", 3);
+  ASSERT_TRUE(c) << d.err();
+  EXPECT_GT(c->received, 200u) << c->line;
+  EXPECT_EQ(c->recorded, c->received) << c->line;
+  EXPECT_EQ(c->record_dropped, 0u) << c->line;
+
+  const drivers::SampleLogContents log = drivers::read_sample_log(recording);
+  EXPECT_TRUE(log.stats.problems.empty()) << log.stats.problems.front().message;
+  ASSERT_EQ(log.header.streams.size(), 1u);
+  EXPECT_EQ(log.header.streams[0].id, 3u);
+  EXPECT_EQ(log.header.streams[0].name, "rec");
+  EXPECT_EQ(log.samples.size(), c->received) << c->line;
+  for (std::size_t i = 0; i < log.samples.size(); ++i) {
+    ASSERT_EQ(log.samples[i].stream_id, 3u) << i;
+    if (i > 0) {
+      ASSERT_GT(log.samples[i].time, log.samples[i - 1].time) << i;
+    }
+  }
+
+  // The recording played back through a second daemon: every sample is emitted.
+  const fs::path replay = dir / "replay.toml";
+  write_text(replay,
+             "[daemon]\nexit_when_sources_end = true\n\n[logging]\nstatus_interval = 0\n\n"
+             "[[stream]]\nid = 3\nname = \"rec\"\nring_capacity = 65536\n"
+             "driver = { type = \"replay\", path = \"live.pflog\", timing = \"fast\" }\n");
+  Subprocess r(daemon_args(replay), dir / "r.out", dir / "r.err");
+  ASSERT_EQ(r.wait(30s), 0) << r.err();
+  EXPECT_NE(r.err().find("every source has ended"), std::string::npos) << r.err();
+  EXPECT_EQ(count_of(r.err(), "warning"), 0u) << r.err();
+  const auto rc = last_counters(r.err(), "rec", 3);
+  ASSERT_TRUE(rc) << r.err();
+  EXPECT_EQ(rc->received, c->received) << rc->line;
+  EXPECT_EQ(rc->dropped, 0u) << rc->line;
+  EXPECT_EQ(rc->emitted, c->received) << rc->line;
+}
+
+TEST(DaemonRecording, ATruncatedRecordingIsPlayedUpToTheDamageWithAWarning) {
+  ScratchDir dir("posefair-e2e-");
+  // A recording of the demo file, made by the daemon's recorder.
+  const fs::path recording = dir / "demo.pflog";
+  const fs::path config = dir / "record.toml";
+  write_text(config, "[daemon]\nexit_when_sources_end = true\n\n[logging]\nstatus_interval = 0\n\n"
+                     "[[stream]]\nid = 5\nname = \"demo\"\nring_capacity = 4096\n"
+                     "driver = { type = \"replay\", path = \"" +
+                         kDemoCsv.string() +
+                         "\", timing = \"fast\" }\n\n"
+                         "[recorder]\npath = \"demo.pflog\"\nsync = false\n");
+  Subprocess d(daemon_args(config), dir / "d.out", dir / "d.err");
+  ASSERT_EQ(d.wait(30s), 0) << d.err();
+  const auto c = last_counters(d.err(), "demo", 5);
+  ASSERT_TRUE(c) << d.err();
+  ASSERT_EQ(c->recorded, kDemoSamples) << c->line;
+  {
+    const auto whole = drivers::read_sample_log(recording);
+    ASSERT_TRUE(whole.stats.problems.empty());
+    ASSERT_EQ(whole.samples.size(), kDemoSamples);
+  }
+
+  // Cut off the last 50 bytes: the last record is no longer whole.
+  fs::resize_file(recording, fs::file_size(recording) - 50);
+  const auto cut = drivers::read_sample_log(recording);
+  ASSERT_EQ(cut.stats.problems.size(), 1u);
+  const std::uint64_t offset = cut.stats.problems[0].offset;
+  const std::size_t intact = cut.samples.size();
+  EXPECT_EQ(intact, kDemoSamples - 1);
+
+  const fs::path replay = dir / "replay.toml";
+  write_text(replay,
+             "[daemon]\nexit_when_sources_end = true\n\n[logging]\nstatus_interval = 0\n\n"
+             "[[stream]]\nid = 5\nname = \"demo\"\nring_capacity = 4096\n"
+             "driver = { type = \"replay\", path = \"demo.pflog\", timing = \"fast\" }\n");
+  Subprocess r(daemon_args(replay), dir / "r.out", dir / "r.err");
+  ASSERT_EQ(r.wait(30s), 0) << r.err();
+  const std::string log = r.err();
+  bool warned = false;
+  for (const std::string& line : lines_of(log))
+    warned = warned || (line.find(" warning: ") != std::string::npos &&
+                        line.find("offset " + std::to_string(offset)) != std::string::npos);
+  EXPECT_TRUE(warned) << "no warning naming offset " << offset << ":\n" << log;
+  std::printf("replay of the truncated recording (%zu intact samples, damage at offset %llu):\n%s", intact,
+              static_cast<unsigned long long>(offset), log.c_str());
+  const auto rc = last_counters(log, "demo", 5);
+  ASSERT_TRUE(rc) << log;
+  EXPECT_EQ(rc->received, intact) << rc->line;
+  EXPECT_EQ(rc->emitted, intact) << rc->line;
+}
+
+// ---------------------------------------------------------------------------------------------
+// 6. Malformed configs through the real binary
+
+struct BadRow {
+  const char* name;
+  std::string toml;
+  std::string at;   // text of the offending line (its line number is computed from it)
+  std::string key;  // must appear in the message ("" for a syntax error: toml++ names no key)
+};
+
+std::uint32_t line_of(const std::string& toml, const std::string& at) {
+  const auto p = toml.find(at);
+  if (p == std::string::npos) throw std::logic_error("row text not found: " + at);
+  return static_cast<std::uint32_t>(1 + std::count(toml.begin(), toml.begin() + static_cast<std::ptrdiff_t>(p), '\n'));
+}
+
+// A config that would end by itself at once if it were (wrongly) accepted.
+const std::string kPrelude = "[daemon]\nexit_when_sources_end = true\n\n";
+const std::string kStream1 = "[[stream]]\nid = 1\nname = \"a\"\ndriver = { type = \"synthetic\", duration = 0.1 }\n";
+
+std::vector<BadRow> bad_rows() {
+  return {
+      {"syntax error", kPrelude + kStream1 + "[stream.engine]\nwindow = = 16\n", "window = = 16", ""},
+      {"unknown key", kPrelude + "[engine]\nwindw = 16\n\n" + kStream1, "windw = 16", "engine.windw"},
+      {"bad value", kPrelude + kStream1 + "[stream.engine]\nwindow = \"x\"\n", "window = \"x\"",
+       "stream[1].engine.window"},
+      {"missing replay file",
+       kPrelude + "[[stream]]\nid = 1\nname = \"a\"\n[stream.driver]\ntype = \"replay\"\npath = \"no-such-file.csv\"\n",
+       "path = \"no-such-file.csv\"", "stream[1].driver.path"},
+      {"duplicate stream id",
+       kPrelude + kStream1 + "\n[[stream]]\nid = 1 # again\nname = \"b\"\ndriver = { type = \"synthetic\" }\n",
+       "id = 1 # again", "stream[2].id"},
+      {"ring capacity not a power of two", kPrelude + "[[stream]]\nid = 1\nname = \"a\"\nring_capacity = 1000\n"
+                                                      "driver = { type = \"synthetic\", duration = 0.1 }\n",
+       "ring_capacity = 1000", "stream[1].ring_capacity"},
+      {"lag not below window", kPrelude + kStream1 + "[stream.engine]\nwindow = 8\nlag = 8\n", "lag = 8",
+       "stream[1].engine.lag"},
+  };
+}
+
+TEST(DaemonConfigErrors, MalformedConfigsExit78WithFileLineAndKey) {
+  ScratchDir dir("posefair-e2e-");
+  int n = 0;
+  for (const BadRow& row : bad_rows()) {
+    SCOPED_TRACE(row.name);
+    const fs::path file = dir / ("bad-" + std::to_string(++n) + ".toml");
+    write_text(file, row.toml);
+    const std::string where = file.string() + ":" + std::to_string(line_of(row.toml, row.at)) + ":";
+    for (const bool check : {true, false}) {
+      SCOPED_TRACE(check ? "--check" : "run");
+      std::vector<std::string> args = daemon_args(file);
+      if (check) args.push_back("--check");
+      Subprocess p(args, dir / "out", dir / "err");
+      const auto rc = p.wait(20s);
+      const std::string err = p.err();
+      EXPECT_EQ(rc, kExitConfig) << err;
+      EXPECT_NE(err.find(where), std::string::npos) << "expected '" << where << "' in: " << err;
+      if (!row.key.empty()) {
+        EXPECT_NE(err.find(row.key + ":"), std::string::npos) << row.key << " not in: " << err;
+      }
+      EXPECT_EQ(p.out(), "");
+    }
+  }
+}
+
+TEST(DaemonConfigErrors, AGoodConfigPassesTheCheck) {
+  ScratchDir dir("posefair-e2e-");
+  const fs::path file = dir / "good.toml";
+  write_text(file, kPrelude + kStream1 +
+                       "[stream.engine]\nwindow = 8\nlag = 7\n\n[[output]]\ndestinations = [\"127.0.0.1:9\"]\n");
+  Subprocess p({kPosefaird, "--check", "-c", file.string()}, dir / "out", dir / "err");
+  ASSERT_EQ(p.wait(20s), 0) << p.err();
+  EXPECT_NE(p.out().find(file.string() + ": ok (1 streams, 1 outputs)"), std::string::npos) << p.out();
+}
+
+// ---------------------------------------------------------------------------------------------
+// 7. posefair sub --idle
+
+TEST(SubIdle, ExitsAboutIdleSecondsAfterTheLastDatagram) {
+  ScratchDir dir("posefair-e2e-");
+  Subprocess sub({kPosefair, "sub", "--listen", "127.0.0.1:0", "--idle", "1", "--duration", "30", "--quiet"},
+                 dir / "out", dir / "err");
+  const auto port = sub.wait_for_listening_port(20s);
+  ASSERT_TRUE(port) << sub.err();
+  // The idle clock starts with the first datagram, not at start.
+  std::this_thread::sleep_for(1500ms);
+  ASSERT_TRUE(sub.running()) << "exited before any datagram came: " << sub.err();
+
+  daemon::UdpSocket sender = daemon::UdpSocket::open(AF_INET);
+  const daemon::Endpoint to = *daemon::Endpoint::parse("127.0.0.1:" + std::to_string(*port));
+  Clock::time_point last_sent;
+  for (std::uint64_t i = 0; i < 6; ++i) {
+    daemon::PoseMessage m;
+    m.session = 7;
+    m.stream = 1;
+    m.sequence = i;
+    m.sample_time = 0.1 * static_cast<double>(i);
+    const auto bytes = daemon::encode_binary(m);
+    ASSERT_TRUE(sender.send_to(bytes, to));
+    last_sent = Clock::now();
+    std::this_thread::sleep_for(300ms);  // shorter than --idle: it keeps running
+    ASSERT_TRUE(sub.running()) << "exited " << i << " datagrams in: " << sub.err();
+  }
+  // 6 × 300 ms after the first datagram is beyond the idle second: only the latest counts.
+  ASSERT_TRUE(wait_until([&] { return !sub.running(); }, 15s)) << "still running 15 s after the last datagram";
+  const double after = std::chrono::duration<double>(Clock::now() - last_sent).count();
+  EXPECT_GE(after, 0.9) << "exited too early";
+  EXPECT_LE(after, 4.0) << "exited too late";
+  EXPECT_EQ(sub.wait(1s), 0) << sub.err();
+  EXPECT_NE(sub.err().find("stats: received 6, lost 0"), std::string::npos) << sub.err();
+}
+
+}  // namespace
+}  // namespace posefair::testing
