@@ -10,7 +10,10 @@
 //   DaemonConfigErrors.*      malformed configs exit 78 with FILE:LINE: and the key
 //   SubIdle.*                 `posefair sub --idle`
 #include <signal.h>
+#include <poll.h>
 #include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -738,6 +741,88 @@ TEST(SubIdle, ExitsAboutIdleSecondsAfterTheLastDatagram) {
   EXPECT_LE(after, 4.0) << "exited too late";
   EXPECT_EQ(sub.wait(1s), 0) << sub.err();
   EXPECT_NE(sub.err().find("stats: received 6, lost 0"), std::string::npos) << sub.err();
+}
+
+}  // namespace
+}  // namespace posefair::testing
+
+// ---------------------------------------------------------------------------------------------
+// 8. systemd: READY=1, STATUS=, WATCHDOG=1, STOPPING=1 through a NOTIFY_SOCKET of the test's
+//    own (sd_notify's protocol: one datagram per message to an AF_UNIX socket); SIGUSR1 logs
+//    the counters.
+
+namespace posefair::testing {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+class NotifySocket {
+ public:
+  explicit NotifySocket(const fs::path& path) : path_(path) {
+    fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    if (fd_ < 0) throw std::runtime_error("socket(AF_UNIX)");
+    sockaddr_un addr{};
+    addr.sun_family = AF_UNIX;
+    std::snprintf(addr.sun_path, sizeof addr.sun_path, "%s", path.c_str());
+    if (::bind(fd_, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) throw std::runtime_error("bind " + path.string());
+  }
+  ~NotifySocket() { ::close(fd_); }
+  // Every message that arrives within `timeout`, in order.
+  std::vector<std::string> drain(std::chrono::milliseconds timeout) {
+    std::vector<std::string> got;
+    const auto deadline = Clock::now() + timeout;
+    for (;;) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+      if (left <= 0) return got;
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, static_cast<int>(left)) <= 0) continue;
+      char buf[4096];
+      const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
+      if (n > 0) got.emplace_back(buf, static_cast<std::size_t>(n));
+    }
+  }
+
+ private:
+  fs::path path_;
+  int fd_ = -1;
+};
+
+TEST(DaemonSystemd, NotifiesReadyStatusWatchdogAndStoppingAndLogsCountersOnSigusr1) {
+  ScratchDir dir("posefair-e2e-");
+  Collector poses;
+  const fs::path config = dir / "posefaird.toml";
+  write_text(config, synthetic_config(poses.port(), false));
+  NotifySocket notify(dir / "notify.sock");
+  // The child inherits the environment: set it for the spawn only.
+  ::setenv("NOTIFY_SOCKET", (dir / "notify.sock").c_str(), 1);
+  ::setenv("WATCHDOG_USEC", "400000", 1);  // 0.4 s: posefaird pets it every 0.1 s
+  Subprocess d(daemon_args(config), dir / "d.out", dir / "d.err");
+  ::unsetenv("NOTIFY_SOCKET");
+  ::unsetenv("WATCHDOG_USEC");
+
+  std::vector<std::string> messages = notify.drain(2500ms);
+  ASSERT_TRUE(d.running()) << d.err();
+  auto count = [&](const std::string& prefix) {
+    return std::count_if(messages.begin(), messages.end(), [&](const std::string& m) { return m.find(prefix) != std::string::npos; });
+  };
+  EXPECT_GE(count("READY=1"), 1) << "no READY=1";
+  EXPECT_GE(count("WATCHDOG=1"), 5) << "the watchdog is petted every quarter of WATCHDOG_USEC";
+  // STATUS= once a second with the stream's name, its rate and drops.
+  bool status_with_rate = false;
+  for (const std::string& m : messages)
+    if (m.rfind("STATUS=one ", 0) == 0 && m.find("/s drop 0 p99 ") != std::string::npos) status_with_rate = true;
+  EXPECT_TRUE(status_with_rate) << "no STATUS= line with the stream's rate; got " << messages.size() << " messages";
+
+  d.send_signal(SIGUSR1);
+  EXPECT_TRUE(wait_for_log_or_exit(d, "stream one (id 1, synthetic:200Hz): received ", 5s)) << d.err();
+  EXPECT_TRUE(d.running());
+
+  d.send_signal(SIGTERM);
+  ASSERT_EQ(d.wait(15s), 0) << d.err();
+  const std::vector<std::string> last = notify.drain(200ms);
+  EXPECT_TRUE(std::any_of(last.begin(), last.end(), [](const std::string& m) { return m.find("STOPPING=1") != std::string::npos; }))
+      << "no STOPPING=1 at SIGTERM";
 }
 
 }  // namespace
