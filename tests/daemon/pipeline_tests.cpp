@@ -351,3 +351,64 @@ TEST(Pipeline, EveryPoseOfALongEnginePassIsPublished) {
 
 }  // namespace
 }  // namespace posefair::daemon
+
+namespace posefair::daemon {
+namespace {
+
+// Two outputs of one stream: binary with angular velocity and JSON lines without. Both get every
+// pose with the same sequence numbers and bit-identical values (JSON numbers round-trip), and
+// the rate is 2 log(q_prev⁻¹ q)/dt of the poses actually sent. A third output that lists only
+// stream 2 gets stream 2 alone.
+TEST(Pipeline, BinaryAndJsonOutputsCarryTheSamePosesAndOutputsHonourTheirStreams) {
+  Receiver binary, json, only_two;
+  std::string text = replay_config(binary.port(), 4096, "drop-oldest");
+  text += "angular_velocity = true\n";
+  text += "\n[[output]]\nencoding = \"json\"\ndestinations = [\"127.0.0.1:" + std::to_string(json.port()) + "\"]\n";
+  text += "\n[[output]]\nstreams = [2]\ndestinations = [\"127.0.0.1:" + std::to_string(only_two.port()) + "\"]\n";
+  text += "\n[[stream]]\nid = 2\nname = \"synthetic\"\n[stream.driver]\ntype = \"synthetic\"\nrate_hz = 1000.0\nduration = 0.2\n";
+  const DaemonConfig config = parse_config(text, "/virtual/outputs.toml");
+  {
+    Pipeline pipeline(config, kSession, {}, false, {});
+    pipeline.start();
+    ASSERT_TRUE(wait_until([&] { return pipeline.sources_ended(); }, 30s));
+    pipeline.stop();
+  }
+  binary.drain();
+  json.drain();
+  only_two.drain();
+  auto of_stream = [](const std::vector<PoseMessage>& all, std::uint32_t id) {
+    std::vector<PoseMessage> out;
+    for (const PoseMessage& m : all)
+      if (m.stream == id) out.push_back(m);
+    return out;
+  };
+  const auto b = of_stream(binary.messages(), 1);
+  const auto j = of_stream(json.messages(), 1);
+  ASSERT_EQ(b.size(), kDemoSamples);
+  ASSERT_EQ(j.size(), kDemoSamples);
+  EXPECT_EQ(binary.malformed() + json.malformed(), 0u);
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    ASSERT_EQ(b[i].sequence, i);
+    ASSERT_EQ(j[i].sequence, i);
+    EXPECT_EQ(b[i].orientation.coeffs(), j[i].orientation.coeffs()) << i;
+    ASSERT_TRUE(b[i].position && j[i].position);
+    EXPECT_EQ(*b[i].position, *j[i].position) << i;
+    EXPECT_FALSE(j[i].angular_velocity) << "the JSON output did not ask for the rate";
+    if (i == 0) {
+      EXPECT_FALSE(b[i].angular_velocity) << "no rate before a second pose";
+      continue;
+    }
+    ASSERT_TRUE(b[i].angular_velocity) << i;
+    const Vec3 expected = 2.0 * so3::log(b[i - 1].orientation.conjugate() * b[i].orientation) /
+                          (b[i].sample_time - b[i - 1].sample_time);
+    EXPECT_LT((*b[i].angular_velocity - expected).norm(), 1e-9 * (1.0 + expected.norm())) << i;
+  }
+  // The output for stream 2 only.
+  const auto two = only_two.messages();
+  ASSERT_FALSE(two.empty());
+  for (const PoseMessage& m : two) ASSERT_EQ(m.stream, 2u);
+  EXPECT_EQ(two.size(), of_stream(binary.messages(), 2).size());
+}
+
+}  // namespace
+}  // namespace posefair::daemon
