@@ -185,6 +185,7 @@ void Pipeline::stop(bool keep_recorder) {
 }
 
 void Pipeline::engine_loop() {
+  if (hooks_.on_realtime_thread_start) hooks_.on_realtime_thread_start();
   for (;;) {
     const std::uint32_t seen = engine_wake_.prepare();
     heartbeat_.fetch_add(1, std::memory_order_relaxed);
@@ -229,6 +230,7 @@ void Pipeline::engine_loop() {
 }
 
 void Pipeline::publisher_loop() {
+  if (hooks_.on_realtime_thread_start) hooks_.on_realtime_thread_start();
   for (;;) {
     const std::uint32_t seen = publisher_wake_.prepare();
     bool any = false;

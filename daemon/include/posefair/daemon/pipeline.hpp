@@ -28,6 +28,9 @@ namespace posefair::daemon {
 struct PipelineHooks {
   // Called on the engine thread before each sample is faired (tests: a deliberately slow consumer).
   std::function<void(std::uint32_t stream_id)> before_engine_sample;
+  // Called first thing on the engine thread and on the publisher thread (tests: count what
+  // those threads allocate).
+  std::function<void()> on_realtime_thread_start;
 };
 
 class Pipeline {
