@@ -1,10 +1,7 @@
-// FairingWindow's promise that push() and flush() never allocate. This binary replaces the
-// global operator new/delete with counting versions, so it must not share an executable with
-// other tests.
-#include <atomic>
+// FairingWindow's promise that push() and flush() never allocate. This binary links
+// tests/support/counting_allocator.cpp, which replaces the global operator new/delete with
+// counting versions, so it must not share an executable with other tests.
 #include <cstddef>
-#include <cstdlib>
-#include <cstring>
 #include <new>
 #include <string>
 #include <vector>
@@ -14,98 +11,31 @@
 #include "posefair/core/fairing_window.hpp"
 #include "posefair/core/synthetic_motion.hpp"
 
-namespace {
-
-std::atomic<std::size_t> g_allocations{0};
-std::atomic<std::ptrdiff_t> g_live_bytes{0};  // requested bytes not yet freed
-void* volatile g_sink = nullptr;  // pointers escape here so test allocations cannot be elided
-
-// Each block carries its requested size in a header in front of it (kHeader bytes, or the
-// alignment for over-aligned blocks) so that the unsized deletes can account for it too.
-constexpr std::size_t kHeader = alignof(std::max_align_t);
-
-void* counted_alloc(std::size_t size, std::size_t align) {
-  const std::size_t header = align > kHeader ? align : kHeader;
-  const std::size_t total = (size + header + header - 1) / header * header;  // aligned_alloc wants a multiple
-  auto* base = static_cast<unsigned char*>(align > kHeader ? std::aligned_alloc(align, total) : std::malloc(total));
-  if (base == nullptr) return nullptr;
-  std::memcpy(base, &size, sizeof size);
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  g_live_bytes.fetch_add(static_cast<std::ptrdiff_t>(size), std::memory_order_relaxed);
-  return base + header;
-}
-
-// Out of line, so that GCC does not see free() applied to what operator new returned once the
-// replacement deletes are inlined (-Wmismatched-new-delete cannot tell they belong together).
-[[gnu::noinline]] void counted_free(void* p, std::size_t align) noexcept {
-  if (p == nullptr) return;
-  const std::size_t header = align > kHeader ? align : kHeader;
-  unsigned char* base = static_cast<unsigned char*>(p) - header;
-  std::size_t size = 0;
-  std::memcpy(&size, base, sizeof size);
-  g_live_bytes.fetch_sub(static_cast<std::ptrdiff_t>(size), std::memory_order_relaxed);
-  std::free(base);
-}
-
-void* alloc_or_throw(std::size_t size, std::size_t align) {
-  if (void* p = counted_alloc(size, align)) return p;
-  throw std::bad_alloc();
-}
-
-}  // namespace
-
-// Every replaceable allocation function.
-void* operator new(std::size_t size) { return alloc_or_throw(size, 0); }
-void* operator new[](std::size_t size) { return alloc_or_throw(size, 0); }
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return counted_alloc(size, 0); }
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return counted_alloc(size, 0); }
-void* operator new(std::size_t size, std::align_val_t al) { return alloc_or_throw(size, static_cast<std::size_t>(al)); }
-void* operator new[](std::size_t size, std::align_val_t al) { return alloc_or_throw(size, static_cast<std::size_t>(al)); }
-void* operator new(std::size_t size, std::align_val_t al, const std::nothrow_t&) noexcept {
-  return counted_alloc(size, static_cast<std::size_t>(al));
-}
-void* operator new[](std::size_t size, std::align_val_t al, const std::nothrow_t&) noexcept {
-  return counted_alloc(size, static_cast<std::size_t>(al));
-}
-void operator delete(void* p) noexcept { counted_free(p, 0); }
-void operator delete[](void* p) noexcept { counted_free(p, 0); }
-void operator delete(void* p, std::size_t) noexcept { counted_free(p, 0); }
-void operator delete[](void* p, std::size_t) noexcept { counted_free(p, 0); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { counted_free(p, 0); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { counted_free(p, 0); }
-void operator delete(void* p, std::align_val_t al) noexcept { counted_free(p, static_cast<std::size_t>(al)); }
-void operator delete[](void* p, std::align_val_t al) noexcept { counted_free(p, static_cast<std::size_t>(al)); }
-void operator delete(void* p, std::size_t, std::align_val_t al) noexcept { counted_free(p, static_cast<std::size_t>(al)); }
-void operator delete[](void* p, std::size_t, std::align_val_t al) noexcept { counted_free(p, static_cast<std::size_t>(al)); }
-void operator delete(void* p, std::align_val_t al, const std::nothrow_t&) noexcept {
-  counted_free(p, static_cast<std::size_t>(al));
-}
-void operator delete[](void* p, std::align_val_t al, const std::nothrow_t&) noexcept {
-  counted_free(p, static_cast<std::size_t>(al));
-}
+#include "../support/counting_allocator.hpp"
 
 namespace posefair {
 namespace {
 
-std::size_t allocations() { return g_allocations.load(std::memory_order_relaxed); }
-std::ptrdiff_t live_bytes() { return g_live_bytes.load(std::memory_order_relaxed); }
+using testing::allocations;
+using testing::keep;
+using testing::live_bytes;
 
 TEST(WindowAllocation, TheCounterSeesAllocations) {
   // Without this the zero below would prove nothing.
   const std::size_t before = allocations();
   auto* v = new std::vector<double>(100);
-  g_sink = v;
+  keep(v);
   auto* aligned = new Eigen::Matrix4d[3];
-  g_sink = aligned;
+  keep(aligned);
   auto* over_aligned = new (std::align_val_t{64}) double[5];
-  g_sink = over_aligned;
+  keep(over_aligned);
   delete v;
   delete[] aligned;
   ::operator delete[](over_aligned, std::align_val_t{64});
   EXPECT_GE(allocations() - before, 4u);  // the vector, its buffer, the array, the aligned block
   const std::ptrdiff_t live = live_bytes();
   auto* block = new double[1000];
-  g_sink = block;
+  keep(block);
   EXPECT_EQ(live_bytes() - live, static_cast<std::ptrdiff_t>(1000 * sizeof(double)));
   delete[] block;
   EXPECT_EQ(live_bytes(), live);

@@ -1,0 +1,239 @@
+// daemon::Pipeline's promise that the engine thread and the publisher thread do not allocate
+// (docs/operations.md), counted over whole runs: each of the two threads claims a counter slot
+// of the counting allocator in PipelineHooks::on_realtime_thread_start, the first thing it
+// does, and the test reads the slots after stop() has joined the threads (the slots are static
+// storage, so they outlive the threads). A JSON-lines output, which allocates a string per pose
+// on the publisher thread, shows that the slots do see those threads' allocations.
+//
+// This binary links tests/support/counting_allocator.cpp, which replaces the global operator
+// new/delete: it must hold only allocation tests.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "posefair/daemon/config.hpp"
+#include "posefair/daemon/pipeline.hpp"
+#include "posefair/daemon/udp_socket.hpp"
+
+#include "../support/counting_allocator.hpp"
+
+namespace posefair::daemon {
+namespace {
+
+namespace counting = posefair::testing;
+using namespace std::chrono_literals;
+
+const std::filesystem::path kDemoCsv = std::filesystem::path(POSEFAIR_SOURCE_DIR) / "data/demo/broad-07-excerpt.csv";
+constexpr std::uint64_t kDemoSamples = 2000;
+constexpr std::uint32_t kSession = 0x5eed0a11u;
+
+// The destination of the pipeline's output: a socket of the test's own on 127.0.0.1, drained
+// by a thread so the kernel's receive buffer never fills. Counts the datagrams.
+class Receiver {
+ public:
+  Receiver() {
+    ReceiveOptions ro;
+    ro.receive_buffer_bytes = 8 << 20;
+    socket_ = UdpSocket::bind(*Endpoint::parse("127.0.0.1:0"), ro);
+    thread_ = std::thread([this] { loop(); });
+  }
+  ~Receiver() { stop(); }
+  Receiver(const Receiver&) = delete;
+  Receiver& operator=(const Receiver&) = delete;
+
+  std::uint16_t port() const { return socket_.local_endpoint().port(); }
+  std::uint64_t datagrams() const { return datagrams_.load(); }
+
+  // Ends the thread once nothing has arrived for `quiet` (bounded by `limit` overall).
+  void drain(std::chrono::milliseconds quiet = 100ms, std::chrono::milliseconds limit = 5s) {
+    const auto deadline = std::chrono::steady_clock::now() + limit;
+    for (;;) {
+      const std::uint64_t before = datagrams();
+      std::this_thread::sleep_for(quiet);
+      if (datagrams() == before || std::chrono::steady_clock::now() > deadline) break;
+    }
+    stop();
+  }
+
+ private:
+  void stop() {
+    stop_.store(true);
+    if (thread_.joinable()) thread_.join();
+  }
+  void loop() {
+    std::vector<std::uint8_t> buffer(65536);
+    while (!stop_.load())
+      if (socket_.receive(buffer, 20ms)) datagrams_.fetch_add(1);
+  }
+
+  UdpSocket socket_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> datagrams_{0};
+};
+
+bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(5ms);
+  }
+  return true;
+}
+
+// One stream (id 1) with the given driver table body and engine keys, and one output to
+// 127.0.0.1:port with the given encoding.
+std::string config_text(std::uint16_t port, const std::string& driver, const std::string& solver,
+                        const std::string& encoding) {
+  return "[daemon]\nsession_id = " + std::to_string(kSession) +
+         "\n\n"
+         "[[stream]]\n"
+         "id = 1\n"
+         "name = \"alloc\"\n"
+         "ring_capacity = 4096\n"
+         "[stream.driver]\n" +
+         driver +
+         "[stream.engine]\n"
+         "solver = \"" +
+         solver +
+         "\"\n"
+         "order = 3\n"
+         "window = 32\n"
+         "lag = 4\n"
+         "\n"
+         "[[output]]\n"
+         "encoding = \"" +
+         encoding +
+         "\"\n"
+         "destinations = [\"127.0.0.1:" +
+         std::to_string(port) + "\"]\n";
+}
+
+std::string replay_driver() { return "type = \"replay\"\npath = \"" + kDemoCsv.string() + "\"\ntiming = \"fast\"\n"; }
+
+struct PipelineRun {
+  bool ended = false;                     // the source ended on its own
+  int threads = 0;                        // real-time threads that claimed a counter slot
+  std::vector<std::size_t> allocations;   // per claimed slot, over the whole run
+  StreamStats stats;
+  std::uint64_t datagrams = 0;
+};
+
+// Runs the pipeline until its source ends, stops it (which joins the engine and publisher
+// threads) and reads what each real-time thread allocated.
+PipelineRun run_pipeline(const std::string& driver, const std::string& solver, const std::string& encoding) {
+  PipelineRun run;
+  Receiver receiver;
+  const DaemonConfig config =
+      parse_config(config_text(receiver.port(), driver, solver, encoding), "/virtual/pipeline-alloc.toml");
+  PipelineHooks hooks;
+  // Stateless, so calling it allocates nothing; claiming a slot does not allocate either.
+  hooks.on_realtime_thread_start = [] { counting::claim_counter_slot(); };
+  {
+    Pipeline pipeline(config, kSession, {}, false, hooks);
+    pipeline.start();
+    run.ended = wait_until([&] { return pipeline.sources_ended(); }, 30s);
+    pipeline.stop();
+    const std::vector<StreamStats> stats = pipeline.stats();
+    if (!stats.empty()) run.stats = stats.front();
+  }
+  run.threads = counting::counter_slots_claimed();
+  for (int i = 0; i < run.threads; ++i) run.allocations.push_back(counting::slot_allocations(i));
+  receiver.drain();
+  run.datagrams = receiver.datagrams();
+  return run;
+}
+
+std::string describe(const PipelineRun& run) {
+  std::ostringstream s;
+  s << "slots:";
+  for (std::size_t a : run.allocations) s << ' ' << a;
+  s << "; received " << run.stats.received << ", emitted " << run.stats.emitted << ", published " << run.stats.published
+    << ", datagrams " << run.datagrams;
+  return s.str();
+}
+
+class PipelineAllocation : public ::testing::Test {
+ protected:
+  // The threads of any previous run have been joined: the slots are free to reuse.
+  void SetUp() override { counting::release_counter_slots(); }
+};
+
+// The slots themselves: a thread's allocations are counted in its slot, and only its own.
+TEST_F(PipelineAllocation, ASlotCountsItsThreadsAllocationsOnly) {
+  std::atomic<int> slot{-2};
+  std::thread t([&slot] {
+    slot.store(counting::claim_counter_slot());
+    for (int i = 0; i < 3; ++i) {
+      auto* p = new int(i);
+      counting::keep(p);
+      delete p;
+    }
+  });
+  t.join();
+  auto* mine = new std::vector<double>(10);  // the main thread has no slot
+  counting::keep(mine);
+  delete mine;
+  ASSERT_EQ(slot.load(), 0);
+  EXPECT_EQ(counting::counter_slots_claimed(), 1);
+  EXPECT_EQ(counting::slot_allocations(0), 3u);
+  EXPECT_GT(counting::thread_allocations(), 0u);
+}
+
+TEST_F(PipelineAllocation, ReplayToABinaryOutputAllocatesNothingOnTheRealtimeThreads) {
+  const PipelineRun run = run_pipeline(replay_driver(), "linear", "binary");
+  std::printf("%s\n", describe(run).c_str());
+  SCOPED_TRACE(describe(run));
+  EXPECT_TRUE(run.ended) << "the replay did not end";
+  ASSERT_EQ(run.threads, 2) << "the engine and the publisher thread each claim a slot";
+  for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
+  EXPECT_EQ(run.stats.received, kDemoSamples);
+  EXPECT_EQ(run.stats.published, kDemoSamples);
+  EXPECT_EQ(run.stats.send_failures, 0u);
+  EXPECT_GT(run.datagrams, 0u);
+}
+
+TEST_F(PipelineAllocation, GaussNewtonOnASyntheticStreamAllocatesNothingOnTheRealtimeThreads) {
+  const PipelineRun run =
+      run_pipeline("type = \"synthetic\"\nrate_hz = 2000.0\nduration = 0.5\n", "gauss-newton", "binary");
+  std::printf("%s\n", describe(run).c_str());
+  SCOPED_TRACE(describe(run));
+  EXPECT_TRUE(run.ended) << "the synthetic stream did not end";
+  ASSERT_EQ(run.threads, 2) << "the engine and the publisher thread each claim a slot";
+  for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
+  EXPECT_EQ(run.stats.received, 1000u);  // 0.5 s at 2000 Hz
+  EXPECT_EQ(run.stats.published, run.stats.received);
+  EXPECT_EQ(run.stats.send_failures, 0u);
+  EXPECT_GT(run.datagrams, 0u);
+}
+
+// The negative control: JSON lines allocate a string per pose on the publisher thread, so the
+// slots do count those threads' allocations. Which slot is which thread is not known: one of
+// them (the publisher's) allocated, the other (the engine's) still did not.
+TEST_F(PipelineAllocation, AJsonOutputAllocatesOnThePublisherThreadOnly) {
+  const PipelineRun run = run_pipeline(replay_driver(), "linear", "json");
+  std::printf("%s\n", describe(run).c_str());
+  SCOPED_TRACE(describe(run));
+  EXPECT_TRUE(run.ended) << "the replay did not end";
+  ASSERT_EQ(run.threads, 2) << "the engine and the publisher thread each claim a slot";
+  EXPECT_GT(*std::max_element(run.allocations.begin(), run.allocations.end()), 0u)
+      << "the publisher's JSON strings were not counted";
+  EXPECT_EQ(*std::min_element(run.allocations.begin(), run.allocations.end()), 0u) << "the engine thread allocated";
+  EXPECT_EQ(run.stats.published, kDemoSamples);
+  EXPECT_EQ(run.stats.send_failures, 0u);
+  EXPECT_GT(run.datagrams, 0u);
+}
+
+}  // namespace
+}  // namespace posefair::daemon
