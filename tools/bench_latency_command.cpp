@@ -31,6 +31,9 @@ struct LatencyOptions {
   int ring_capacity = 1024;
   int realtime_priority = 0;
   bool aligned = false;  // all streams sample at the same instant (one sync line)
+  // Nobody reads the destination socket (the subscriber is on another machine): the bench then
+  // measures the daemon alone, without a receiver thread competing for the same cores.
+  bool no_receiver = false;
 };
 
 double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
@@ -87,6 +90,7 @@ int bench_latency(const LatencyOptions& o) {
   std::atomic<std::uint64_t> datagrams{0}, lost{0};
   double receiver_cpu = 0.0;
   std::thread receiver([&] {
+    if (o.no_receiver) return;
     std::vector<std::uint8_t> buffer(daemon::kMaxDatagramSize + 1);
     std::map<std::uint32_t, std::uint64_t> next;
     while (!stop.load(std::memory_order_acquire)) {
@@ -101,6 +105,7 @@ int bench_latency(const LatencyOptions& o) {
     }
     receiver_cpu = thread_cpu_seconds();
   });
+  if (o.no_receiver) receiver.join();
 
   std::printf("bench latency: %d streams at %.0f Hz for %.1f s, window %d, lag %d, %s solver, ring %d, realtime priority %d, %s\n",
               o.streams, o.rate, o.duration, o.window, o.lag, o.solver.c_str(), o.ring_capacity, o.realtime_priority,
@@ -115,7 +120,7 @@ int bench_latency(const LatencyOptions& o) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the last datagrams
     stop.store(true, std::memory_order_release);
-    receiver.join();
+    if (receiver.joinable()) receiver.join();
     const double cpu = process_cpu_seconds() - cpu0 - receiver_cpu;
 
     daemon::HistogramSnapshot all;
@@ -144,7 +149,10 @@ int bench_latency(const LatencyOptions& o) {
                 ", send failures %" PRIu64 "; unaccounted %" PRId64 "\n",
                 ring_dropped, publish_dropped, rejected, out_of_order, failures,
                 static_cast<std::int64_t>(received) - static_cast<std::int64_t>(accounted));
-    std::printf("receiver    %" PRIu64 " datagrams, %" PRIu64 " lost (sequence gaps)\n", datagrams.load(), lost.load());
+    if (o.no_receiver)
+      std::printf("receiver    none (datagrams sent to a socket nobody reads)\n");
+    else
+      std::printf("receiver    %" PRIu64 " datagrams, %" PRIu64 " lost (sequence gaps)\n", datagrams.load(), lost.load());
     std::printf("cpu         %.3f s in %.2f s wall: %.1f%% of one core, %.2f%% per stream at %.0f Hz (receiver excluded)\n",
                 cpu, wall, 100.0 * cpu / wall, 100.0 * cpu / wall / o.streams, o.rate);
   }
@@ -167,6 +175,7 @@ void add_bench_latency_command(CLI::App& bench, int& exit_code) {
   cmd->add_option("--realtime-priority", o->realtime_priority, "SCHED_FIFO priority of engine and publisher (0: off)")
       ->capture_default_str()
       ->check(CLI::Range(0, 99));
+  cmd->add_flag("--no-receiver", o->no_receiver, "send to a socket nobody reads (measure the daemon alone)");
   cmd->add_flag("--aligned", o->aligned, "all streams sample at the same instant (default: phases spread over the period)");
   cmd->add_option("--ring", o->ring_capacity, "ring capacity per stream (power of two)")->capture_default_str();
   cmd->callback([o, &exit_code] { exit_code = bench_latency(*o); });

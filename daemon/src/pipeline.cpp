@@ -147,6 +147,8 @@ std::vector<std::string> Pipeline::start() {
     Stream* s = sp.get();
     s->driver_running.store(true, std::memory_order_release);
     driver_threads_.emplace_back([this, s](std::stop_token stop) {
+      // "pf-d-<stream>", cut to the 15 characters Linux keeps.
+      ::pthread_setname_np(::pthread_self(), ("pf-d-" + s->config.name).substr(0, 15).c_str());
       s->driver->run(stop, *s);
       s->driver_running.store(false, std::memory_order_release);
       s->driver_done.store(true, std::memory_order_release);
@@ -185,6 +187,7 @@ void Pipeline::stop(bool keep_recorder) {
 }
 
 void Pipeline::engine_loop() {
+  ::pthread_setname_np(::pthread_self(), "pf-engine");  // for top -H, perf and gdb
   if (hooks_.on_realtime_thread_start) hooks_.on_realtime_thread_start();
   for (;;) {
     const std::uint32_t seen = engine_wake_.prepare();
@@ -230,6 +233,7 @@ void Pipeline::engine_loop() {
 }
 
 void Pipeline::publisher_loop() {
+  ::pthread_setname_np(::pthread_self(), "pf-publish");
   if (hooks_.on_realtime_thread_start) hooks_.on_realtime_thread_start();
   for (;;) {
     const std::uint32_t seen = publisher_wake_.prepare();
@@ -253,6 +257,7 @@ void Pipeline::publisher_loop() {
 }
 
 void Pipeline::recorder_loop() {
+  ::pthread_setname_np(::pthread_self(), "pf-record");
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   for (;;) {
