@@ -1,0 +1,81 @@
+#pragma once
+// A device protocol decoder: bytes in, samples out. Pure: no I/O, no clock, no allocation after
+// construction, never throws on any input, never reads outside what it was given. The serial
+// driver feeds it whatever each read returned (any split of the stream into chunks gives the
+// same samples); fuzz targets and golden replays feed it files.
+//
+// Every decoder resynchronises after garbage (it searches for the next frame start), verifies
+// the frame's checksum before using a byte of it, and counts what it saw. One file per
+// protocol in drivers/src/, opening with a comment that names the reference document and the
+// device's quirks; decoder_registry.cpp lists them (one line per protocol).
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "posefair/core/sample.hpp"
+
+namespace posefair::drivers {
+
+// One orientation (and perhaps position) a frame carried, in posefair's convention: a unit
+// quaternion (w, x, y, z) rotating sensor coordinates into world coordinates, v_w = q v_s q*.
+struct DecodedSample {
+  Quat orientation = Quat::Identity();
+  Vec3 position = Vec3::Zero();
+  std::uint32_t flags = 0;        // kHasPosition, kHasDeviceTime (core/sample.hpp)
+  double device_time = 0.0;       // s, valid with kHasDeviceTime; rollover already unwrapped
+  std::uint64_t frame_counter = 0;  // the device's own packet counter, where it sends one (unwrapped)
+  bool has_frame_counter = false;
+};
+
+struct DecoderCounters {
+  std::uint64_t bytes = 0;           // bytes fed
+  std::uint64_t frames = 0;          // whole frames whose checksum (or CRC) matched
+  std::uint64_t samples = 0;         // samples handed to the sink
+  std::uint64_t bad_checksum = 0;    // whole frames whose checksum did not match
+  std::uint64_t malformed = 0;       // frames with a valid checksum but impossible contents (bad length field, NaN, zero quaternion)
+  std::uint64_t ignored_frames = 0;  // valid frames of kinds without an orientation (e.g. WitMotion 0x51 acceleration)
+  std::uint64_t resyncs = 0;         // times the decoder had to skip bytes to find a frame start
+  std::uint64_t skipped_bytes = 0;   // bytes skipped while resynchronising
+  friend bool operator==(const DecoderCounters&, const DecoderCounters&) = default;
+};
+
+class DecodedSink {
+ public:
+  virtual ~DecodedSink() = default;
+  virtual void on_sample(const DecodedSample& sample) = 0;
+};
+
+// Choices the vendors' documents leave open, per protocol (each decoder's comment says which
+// it reads and what its default is). Strings keep the config layer simple.
+struct DecoderOptions {
+  // WitMotion 0x59: which of the four int16 components is the scalar: "first" (w x y z, the
+  // order of WitMotion's documents) or "last" (x y z w).
+  std::string witmotion_scalar = "first";
+};
+
+class Decoder {
+ public:
+  virtual ~Decoder() = default;
+  // The protocol's registry name, e.g. "witmotion".
+  virtual std::string_view protocol() const = 0;
+  // Consumes every byte of `bytes` (a partial frame at the end is kept for the next call) and
+  // hands every sample of every valid frame to sink, in stream order.
+  virtual void feed(std::span<const std::uint8_t> bytes, DecodedSink& sink) = 0;
+  // Forgets a partial frame and any rollover state (after the device was reopened).
+  virtual void reset() = 0;
+  const DecoderCounters& counters() const { return counters_; }
+
+ protected:
+  DecoderCounters counters_;
+};
+
+// The registry: nullptr for an unknown protocol name. Throws std::invalid_argument for an
+// option value the protocol does not accept.
+std::unique_ptr<Decoder> make_decoder(std::string_view protocol, const DecoderOptions& options = {});
+// Every registered protocol name, sorted.
+std::vector<std::string> decoder_protocols();
+
+}  // namespace posefair::drivers
