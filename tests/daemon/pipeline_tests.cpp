@@ -412,3 +412,44 @@ TEST(Pipeline, BinaryAndJsonOutputsCarryTheSamePosesAndOutputsHonourTheirStreams
 
 }  // namespace
 }  // namespace posefair::daemon
+
+namespace posefair::daemon {
+namespace {
+
+// A multicast output (TTL 0, sent and joined on the loopback interface, so nothing leaves the
+// host): a subscriber that joined the group gets every pose.
+TEST(Pipeline, MulticastOutputReachesAGroupMember) {
+  ReceiveOptions ro;
+  ro.group = *Endpoint::parse("239.255.80.72:0");
+  ro.interface.name_or_address = "127.0.0.1";
+  ro.receive_buffer_bytes = 1 << 20;
+  UdpSocket rx = UdpSocket::bind(*Endpoint::parse("0.0.0.0:0"), ro);
+  const std::string text = "[[stream]]\nid = 3\nname = \"s\"\n[stream.driver]\ntype = \"synthetic\"\nrate_hz = 1000.0\n"
+                           "duration = 0.2\n\n[[output]]\ndestinations = [\"239.255.80.72:" +
+                           std::to_string(rx.local_endpoint().port()) + "\"]\nttl = 0\ninterface = \"127.0.0.1\"\n";
+  const DaemonConfig config = parse_config(text, "/virtual/multicast.toml");
+  ASSERT_EQ(config.outputs.at(0).send.multicast_ttl, 0);
+  std::uint64_t published = 0;
+  {
+    Pipeline pipeline(config, kSession, {}, false, {});
+    pipeline.start();
+    ASSERT_TRUE(wait_until([&] { return pipeline.sources_ended(); }, 30s));
+    pipeline.stop();
+    published = pipeline.stats().at(0).published;
+    EXPECT_EQ(pipeline.stats().at(0).send_failures, 0u);
+  }
+  ASSERT_EQ(published, 200u);
+  std::vector<std::uint8_t> buffer(kMaxDatagramSize + 1);
+  std::uint64_t got = 0;
+  while (auto d = rx.receive(buffer, 500ms)) {
+    const DecodeResult r = decode_datagram(std::span<const std::uint8_t>(buffer.data(), d->size));
+    ASSERT_TRUE(r.ok());
+    EXPECT_EQ(r.message.stream, 3u);
+    EXPECT_EQ(r.message.sequence, got);
+    ++got;
+  }
+  EXPECT_EQ(got, published);
+}
+
+}  // namespace
+}  // namespace posefair::daemon
