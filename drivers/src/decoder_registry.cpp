@@ -3,7 +3,13 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "posefair/drivers/bno08x_rvc_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
+#include "posefair/drivers/posefair_serial_decoder.hpp"
+#include "posefair/drivers/vectornav_decoder.hpp"
+#include "posefair/drivers/witmotion_decoder.hpp"
+#include "posefair/drivers/xsens_decoder.hpp"
+#include "posefair/drivers/yost_decoder.hpp"
 
 namespace posefair::drivers {
 namespace {
@@ -14,7 +20,12 @@ struct Entry {
 };
 
 constexpr Entry kDecoders[] = {
-    {"", nullptr},  // placeholder until the first protocol lands
+    {"bno08x-rvc", make_bno08x_rvc_decoder},
+    {"posefair", make_posefair_serial_decoder},
+    {"vectornav", make_vectornav_decoder},
+    {"xsens", make_xsens_decoder},
+    {"witmotion", make_witmotion_decoder},
+    {"yost", make_yost_decoder},
 };
 
 }  // namespace

@@ -54,6 +54,15 @@ struct DecoderOptions {
   // WitMotion 0x59: which of the four int16 components is the scalar: "first" (w x y z, the
   // order of WitMotion's documents) or "last" (x y z w).
   std::string witmotion_scalar = "first";
+  // VectorNav ASCII: sentences whose checksum field is "XX" (checksums disabled on the device):
+  // "reject" (counted as bad_checksum) or "accept" (used after strict content checks).
+  std::string vectornav_unchecked = "reject";
+  // Yost 3-Space: the wired response header bitfield the device was set to (command 221), as a
+  // number ("79" or "0x4F"); must include success (0x01), checksum (0x08) and data length (0x40).
+  std::string yost_header = "0x4F";
+  // Yost 3-Space: data bytes per streamed packet (the slots' total, 16..255); slot 0 must be
+  // command 0x00, the tared quaternion; bytes after its 16 are skipped.
+  std::string yost_data_length = "16";
 };
 
 class Decoder {

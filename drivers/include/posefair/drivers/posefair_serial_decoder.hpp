@@ -1,0 +1,26 @@
+#pragma once
+// posefair's own serial protocol for microcontroller trackers (docs/protocol.md, "Serial
+// protocol for microcontroller trackers"): the text sentence $PFQ and the binary frame
+// F5 50, interleaved freely on one line. Registry name: "posefair".
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "posefair/drivers/decoder.hpp"
+
+namespace posefair::drivers {
+
+// The decoder of both forms. Reads no option of DecoderOptions.
+std::unique_ptr<Decoder> make_posefair_serial_decoder(const DecoderOptions& options = {});
+
+// The text sentence "$PFQ,<time>,<w>,<x>,<y>,<z>[,<px>,<py>,<pz>]*HH\r\n", every number
+// written in its shortest round-trip form (a sentence decodes to exactly these doubles).
+// position may be null.
+std::string encode_posefair_sentence(std::uint32_t device_time_us, const Quat& q, const Vec3* position);
+
+// The binary frame (version 1): sync F5 50, version, flags, length, u32 LE time in µs, q as
+// 4 × float32 LE, position as 3 × float32 LE when given, CRC-16/CCITT-FALSE LE.
+std::vector<std::uint8_t> encode_posefair_frame(std::uint32_t device_time_us, const Quat& q, const Vec3* position);
+
+}  // namespace posefair::drivers

@@ -1,0 +1,367 @@
+// posefair's serial protocol for microcontroller trackers: registry name "posefair".
+//
+// Reference document: docs/protocol.md, section "Serial protocol for microcontroller trackers"
+// (posefair, protocol version 1; this file and that section are one specification: where
+// they disagree, this file is wrong). Two forms share one line and may be interleaved:
+// - the text sentence "$PFQ,<time µs>,<w>,<x>,<y>,<z>[,<px>,<py>,<pz>]*HH\r\n", HH the XOR of
+//   the bytes between '$' and '*' (upper or lower case hex);
+// - the binary frame F5 50 | version 1 | flags (bit 0: position) | length | u32 LE time µs |
+//   4 × float32 LE w x y z | [3 × float32 LE position, metres] | CRC-16/CCITT-FALSE LE over
+//   version .. payload end.
+// The device time is a u32 count of microseconds that wraps at 2^32 µs (71.6 min), Arduino's
+// micros(); device_time is it in seconds, unwrapped forward-only (each step modulo 2^32, so a
+// device restart looks like a rollover; reset() starts afresh). The text and binary forms
+// share one clock. Every valid frame whose time field reads advances the unwrapping, also one
+// that then turns out malformed (say, by its quaternion).
+//
+// Choices (the document states them for senders and receivers)
+// - The sync bytes F5 50: 0xF5 never occurs in ASCII or UTF-8 text, so neither the sentences
+//   nor an Arduino's debug prints on the same line can start a false binary frame, and F5 50
+//   collides with none of the other protocols' starts (WitMotion 55, BNO08x RVC AA AA, Xsens
+//   FA FF, VectorNav FA, u-blox B5 62, NMEA '$', MAVLink FE/FD, RTCM D3).
+// - Sentences: at most 255 bytes from '$' through '\n'. A candidate sentence is abandoned
+//   (its bytes skipped) at a byte that cannot occur in one (outside 0x20..0x7E, other than
+//   '\r' and '\n') or at a new '$' (the line was cut; the new '$' starts the next sentence).
+//   255 bytes without '\n' count as malformed and are dropped whole (none of them can start a
+//   frame). A line from '$' to '\n' without a well-formed "*HH" ending, or with a checksum that
+//   does not match, counts as bad_checksum and is dropped whole. Valid sentences of other
+//   types ($GPGGA ...) count as ignored_frames.
+// - Binary frames: a length above 64 counts as malformed at once (no waiting for bytes a
+//   corrupt length announces); after a CRC mismatch only the first sync byte is dropped and the
+//   search goes on inside the rejected bytes. A version other than 1 (with a valid CRC) counts
+//   as ignored_frames: later versions may change the payload. Reserved flag bits set, or a
+//   length other than 20 (32 with position), count as malformed.
+// - Numbers in sentences are read with std::from_chars (no spaces, no '+', no hex); the time
+//   is an unsigned decimal integer up to 4294967295. NaN, infinities, out-of-range numbers, a
+//   quaternion whose norm differs from 1 by more than 1e-3 (the UDP protocol's bound) or a
+//   wrong field count make a valid frame malformed. Quaternions are normalised (one that is
+//   unit to rounding is kept exactly, so a sentence round-trips bit for bit).
+// - Every byte fed is either part of a frame whose checksum matched, or counted in
+//   skipped_bytes, or held as the start of an incomplete frame. A run of skipped bytes between
+//   two valid frames is one resync (lines of debug text between sentences are resyncs).
+#include "posefair/drivers/posefair_serial_decoder.hpp"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <optional>
+
+#include "posefair/drivers/byte_order.hpp"
+#include "posefair/drivers/checksums.hpp"
+
+namespace posefair::drivers {
+namespace {
+
+constexpr std::uint8_t kSync0 = 0xF5;
+constexpr std::uint8_t kSync1 = 0x50;
+constexpr std::uint8_t kVersion = 1;
+constexpr std::uint8_t kFlagPosition = 0x01;
+constexpr std::size_t kFrameHeader = 5;       // sync, sync, version, flags, length
+constexpr std::size_t kMaxPayload = 64;
+constexpr std::size_t kMaxSentence = 255;     // '$' through '\n'
+constexpr std::size_t kBufferSize = 1024;
+static_assert(kBufferSize > kMaxSentence && kBufferSize > kFrameHeader + kMaxPayload + 2);
+constexpr double kUnitTolerance = 1e-3;
+constexpr double kMicro = 1e-6;
+
+bool sentence_byte(std::uint8_t b) { return (b >= 0x20 && b <= 0x7E) || b == '\r'; }
+
+int hex_value(std::uint8_t c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  return -1;
+}
+
+// q normalised, or nothing if it is not finite or not unit within the tolerance.
+std::optional<Quat> unit(double w, double x, double y, double z) {
+  Quat q(w, x, y, z);
+  const double n2 = q.squaredNorm();
+  if (!std::isfinite(n2)) return std::nullopt;
+  const double n = std::sqrt(n2);
+  if (!(std::abs(n - 1.0) <= kUnitTolerance)) return std::nullopt;
+  if (std::abs(n2 - 1.0) > 4e-15) q.coeffs() /= n;
+  return q;
+}
+
+class PosefairSerialDecoder final : public Decoder {
+ public:
+  std::string_view protocol() const override { return "posefair"; }
+
+  void feed(std::span<const std::uint8_t> in, DecodedSink& sink) override {
+    counters_.bytes += in.size();
+    while (!in.empty()) {
+      const std::size_t n = std::min(in.size(), buf_.size() - held_);
+      std::memcpy(buf_.data() + held_, in.data(), n);
+      held_ += n;
+      in = in.subspan(n);
+      const std::size_t used = process(sink);
+      std::memmove(buf_.data(), buf_.data() + used, held_ - used);
+      held_ -= used;
+    }
+  }
+
+  void reset() override {
+    held_ = 0;
+    skipping_ = false;
+    have_time_ = false;
+  }
+
+ private:
+  void skip(std::size_t n) {
+    if (n == 0) return;
+    counters_.skipped_bytes += n;
+    if (!skipping_) ++counters_.resyncs;
+    skipping_ = true;
+  }
+
+  void accept_frame() {
+    ++counters_.frames;
+    skipping_ = false;
+  }
+
+  double unwrap_time(std::uint32_t raw) {
+    time_us_ = have_time_ ? time_us_ + static_cast<std::uint32_t>(raw - last_time_) : raw;
+    have_time_ = true;
+    last_time_ = raw;
+    return static_cast<double>(time_us_) * kMicro;
+  }
+
+  std::size_t process(DecodedSink& sink) {
+    std::size_t i = 0;
+    while (i < held_) {
+      const std::uint8_t* p = buf_.data() + i;
+      const std::size_t avail = held_ - i;
+      if (p[0] == '$') {
+        const std::size_t limit = std::min(avail, kMaxSentence);
+        std::size_t j = 1;
+        while (j < limit && p[j] != '\n' && p[j] != '$' && sentence_byte(p[j])) ++j;
+        if (j < limit && p[j] == '\n') {
+          handle_sentence(p, j + 1, sink);
+          i += j + 1;
+          continue;
+        }
+        if (j < limit) {  // cut off by a new '$' or by a byte no sentence holds
+          skip(j);
+          i += j;
+          continue;
+        }
+        if (limit < kMaxSentence) break;  // wait for the rest of the line
+        ++counters_.malformed;            // no '\n' within the bound
+        skip(kMaxSentence);
+        i += kMaxSentence;
+        continue;
+      }
+      if (p[0] == kSync0) {
+        if (avail < 2) break;
+        if (p[1] != kSync1) {
+          skip(1);
+          ++i;
+          continue;
+        }
+        if (avail < kFrameHeader) break;
+        const std::size_t len = p[4];
+        if (len > kMaxPayload) {
+          ++counters_.malformed;
+          skip(1);
+          ++i;
+          continue;
+        }
+        const std::size_t total = kFrameHeader + len + 2;
+        if (avail < total) break;
+        const std::uint16_t crc = checksum::crc16_ccitt({p + 2, 3 + len}, 0xFFFF);
+        if (crc != bytes::le_u16(p + kFrameHeader + len)) {
+          ++counters_.bad_checksum;
+          skip(1);
+          ++i;
+          continue;
+        }
+        accept_frame();
+        handle_frame(p[2], p[3], {p + kFrameHeader, len}, sink);
+        i += total;
+        continue;
+      }
+      std::size_t k = 1;
+      while (k < avail && p[k] != '$' && p[k] != kSync0) ++k;
+      skip(k);
+      i += k;
+    }
+    return i;
+  }
+
+  // line: '$' through '\n' (n bytes), every byte in between a sentence byte.
+  void handle_sentence(const std::uint8_t* line, std::size_t n, DecodedSink& sink) {
+    std::size_t end = n - 1;  // the '\n'
+    if (end > 0 && line[end - 1] == '\r') --end;
+    int h1 = -1, h0 = -1;
+    if (end >= 4 && line[end - 3] == '*') {
+      h1 = hex_value(line[end - 2]);
+      h0 = hex_value(line[end - 1]);
+    }
+    const std::span<const std::uint8_t> body(line + 1, end >= 4 ? end - 4 : 0);
+    if (h1 < 0 || h0 < 0 || std::find(body.begin(), body.end(), '\r') != body.end() ||
+        checksum::xor8(body) != (h1 << 4 | h0)) {
+      ++counters_.bad_checksum;
+      skip(n);
+      return;
+    }
+    accept_frame();
+
+    const char* s = reinterpret_cast<const char*>(body.data());
+    const char* const e = s + body.size();
+    const char* comma = std::find(s, e, ',');
+    if (std::string_view(s, static_cast<std::size_t>(comma - s)) != "PFQ") {
+      ++counters_.ignored_frames;
+      return;
+    }
+    std::array<std::string_view, 9> fields;
+    std::size_t count = 0;
+    while (comma != e) {
+      const char* begin = comma + 1;
+      comma = std::find(begin, e, ',');
+      if (count == fields.size()) {
+        ++counters_.malformed;
+        return;
+      }
+      fields[count++] = std::string_view(begin, static_cast<std::size_t>(comma - begin));
+    }
+    if (count != 5 && count != 8) {
+      ++counters_.malformed;
+      return;
+    }
+    double device_time = 0.0;
+    {
+      const std::string_view f = fields[0];
+      std::uint64_t t = 0;
+      const auto [ptr, ec] = std::from_chars(f.data(), f.data() + f.size(), t);
+      if (f.empty() || ec != std::errc() || ptr != f.data() + f.size() || t > 0xFFFFFFFFu) {
+        ++counters_.malformed;
+        return;
+      }
+      device_time = unwrap_time(static_cast<std::uint32_t>(t));
+    }
+    std::array<double, 7> v{};
+    for (std::size_t k = 1; k < count; ++k) {
+      const std::string_view f = fields[k];
+      const auto [ptr, ec] = std::from_chars(f.data(), f.data() + f.size(), v[k - 1]);
+      if (f.empty() || ec != std::errc() || ptr != f.data() + f.size() || !std::isfinite(v[k - 1])) {
+        ++counters_.malformed;
+        return;
+      }
+    }
+    const std::optional<Quat> q = unit(v[0], v[1], v[2], v[3]);
+    if (!q) {
+      ++counters_.malformed;
+      return;
+    }
+    DecodedSample sample;
+    sample.orientation = *q;
+    sample.flags = kHasDeviceTime;
+    if (count == 8) {
+      sample.position = Vec3(v[4], v[5], v[6]);
+      sample.flags |= kHasPosition;
+    }
+    sample.device_time = device_time;
+    ++counters_.samples;
+    sink.on_sample(sample);
+  }
+
+  void handle_frame(std::uint8_t version, std::uint8_t flags, std::span<const std::uint8_t> payload,
+                    DecodedSink& sink) {
+    if (version != kVersion) {
+      ++counters_.ignored_frames;
+      return;
+    }
+    const bool has_position = (flags & kFlagPosition) != 0;
+    if ((flags & ~kFlagPosition) != 0 || payload.size() != (has_position ? 32u : 20u)) {
+      ++counters_.malformed;
+      return;
+    }
+    const std::uint8_t* d = payload.data();
+    const double device_time = unwrap_time(bytes::le_u32(d));
+    const std::optional<Quat> q =
+        unit(bytes::le_f32(d + 4), bytes::le_f32(d + 8), bytes::le_f32(d + 12), bytes::le_f32(d + 16));
+    if (!q) {
+      ++counters_.malformed;
+      return;
+    }
+    DecodedSample sample;
+    sample.orientation = *q;
+    sample.flags = kHasDeviceTime;
+    if (has_position) {
+      const Vec3 pos(bytes::le_f32(d + 20), bytes::le_f32(d + 24), bytes::le_f32(d + 28));
+      if (!pos.allFinite()) {
+        ++counters_.malformed;
+        return;
+      }
+      sample.position = pos;
+      sample.flags |= kHasPosition;
+    }
+    sample.device_time = device_time;
+    ++counters_.samples;
+    sink.on_sample(sample);
+  }
+
+  std::array<std::uint8_t, kBufferSize> buf_{};
+  std::size_t held_ = 0;
+  bool skipping_ = false;
+  bool have_time_ = false;
+  std::uint32_t last_time_ = 0;
+  std::uint64_t time_us_ = 0;
+};
+
+void append_number(std::string& out, double v) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, v);
+  out.append(buffer, result.ptr);
+}
+
+}  // namespace
+
+std::unique_ptr<Decoder> make_posefair_serial_decoder(const DecoderOptions& /*options*/) {
+  return std::make_unique<PosefairSerialDecoder>();
+}
+
+std::string encode_posefair_sentence(std::uint32_t device_time_us, const Quat& q, const Vec3* position) {
+  std::string s = "$PFQ,";
+  s += std::to_string(device_time_us);
+  for (double v : {q.w(), q.x(), q.y(), q.z()}) {
+    s += ',';
+    append_number(s, v);
+  }
+  if (position)
+    for (int k = 0; k < 3; ++k) {
+      s += ',';
+      append_number(s, (*position)[k]);
+    }
+  const std::uint8_t x =
+      checksum::xor8({reinterpret_cast<const std::uint8_t*>(s.data()) + 1, s.size() - 1});
+  constexpr char kHex[] = "0123456789ABCDEF";
+  s += '*';
+  s += kHex[x >> 4];
+  s += kHex[x & 0xF];
+  s += "\r\n";
+  return s;
+}
+
+std::vector<std::uint8_t> encode_posefair_frame(std::uint32_t device_time_us, const Quat& q, const Vec3* position) {
+  const std::size_t len = position ? 32 : 20;
+  std::vector<std::uint8_t> f(kFrameHeader + len + 2);
+  f[0] = kSync0;
+  f[1] = kSync1;
+  f[2] = kVersion;
+  f[3] = position ? kFlagPosition : 0;
+  f[4] = static_cast<std::uint8_t>(len);
+  std::uint8_t* d = f.data() + kFrameHeader;
+  bytes::put_le_u32(d, device_time_us);
+  const double comps[4] = {q.w(), q.x(), q.y(), q.z()};
+  for (int k = 0; k < 4; ++k) bytes::put_le_f32(d + 4 + 4 * k, static_cast<float>(comps[k]));
+  if (position)
+    for (int k = 0; k < 3; ++k) bytes::put_le_f32(d + 20 + 4 * k, static_cast<float>((*position)[k]));
+  bytes::put_le_u16(d + len, checksum::crc16_ccitt({f.data() + 2, 3 + len}, 0xFFFF));
+  return f;
+}
+
+}  // namespace posefair::drivers

@@ -1,0 +1,330 @@
+// WitMotion serial protocol decoder ("witmotion").
+//
+// Reference documents (WitMotion Shenzhen Co., Ltd., http://wiki.wit-motion.com/english):
+//   - "WT901 Datasheet" v20-0702, ch. 5 Communication Protocol: 5.1.4 Angle Output (0x53, its
+//     axis and Euler-order note), 5.2.8 Return Content (the RSW bits that enable each packet).
+//   - "WT901SDCL Datasheet" v20-0605, ch. 6: 6.1.1 Time Output (0x50), 6.1.6 Quaternion (0x59).
+//   - docs.wit-motion.com, HWT905-TTL "Protocol" page (the same packet layouts).
+// Every packet is 11 bytes: 0x55, a type byte, four little-endian 16-bit words, and SUM = the
+// low byte of the sum of the first 10 bytes.
+//
+// What is decoded:
+//   0x59 quaternion: Q0..Q3 = int16 / 32768. The documents list Q0 first and, in the usual Q0
+//     notation, Q0 is the scalar, so the default is witmotion_scalar = "first" (w x y z);
+//     "last" (x y z w) is there for firmware or bridges that reorder. A device at rest in its
+//     reference attitude sends Q0 ≈ 1 with "first". int16 cannot hold +1.0 (32767/32768), so
+//     the quaternion is renormalised; one whose norm is outside [0.9, 1.1] (all zeros, or a
+//     corrupted frame whose checksum still matched) counts as malformed.
+//   0x53 angles: roll (X), pitch (Y), yaw (Z) = int16 · 180/32768 degrees, then a version word
+//     (temperature on older models), unused. The documents: "Euler angle represents the rotation
+//     order of the coordinate system when the attitude is defined as Z-Y-X, that is, first turn
+//     around the Z-axis, then turn around the Y-axis, and then turn around the X-axis". Read as
+//     intrinsic z-y'-x'' (aerospace) angles with right-handed positive rotations, the rotation
+//     from sensor to world is R = Rz(yaw) · Ry(pitch) · Rx(roll); euler_to_quat({Z, Y, X}) is
+//     exactly that composition, so it is reused. The documents give pitch a range of ±90°; a
+//     frame with |pitch| > 90° counts as malformed.
+//   0x50 time: YY MM DD hh mm ss, then milliseconds (16 bit). The document's checksum line for
+//     this packet reads "0x55+0x51+...+TL" (copied from 0x51); the device sums the first 10 bytes
+//     like every other packet, and so does this decoder.
+//   0x51 accel, 0x52 gyro, 0x54 mag, 0x55 port, 0x56 pressure, 0x57/0x58/0x5A GPS, and the
+//     undocumented 0x5B..0x5F: valid frames, counted as ignored_frames. A type byte outside
+//     0x50..0x5F is not a frame start (the 0x55 is skipped as garbage), which makes a false
+//     start in garbage 16 times rarer than accepting any type.
+//
+// Choices:
+//   - Quaternion preferred: a device may send both 0x53 and 0x59 each cycle; once a 0x59 has
+//     been seen, 0x53 frames are ignored_frames. Two 0x53 frames with no 0x59 between them mean
+//     the quaternion output was switched off, and 0x53 frames produce samples again (so the
+//     first cycle of a device sending both gives two samples, and a switch-off loses one).
+//   - Device time: a valid 0x50 frame stamps (kHasDeviceTime) the samples that follow it in the
+//     same output cycle. The cycle ends at the next 0x50, or when a packet type repeats without a
+//     0x50 in between (the time frame of that cycle was lost): samples then carry no device time
+//     rather than a stale one. device_time = the time of day (hh:mm:ss.ms) plus 86400 s per day
+//     rollover, detected as the time of day falling back by more than 12 hours; smaller steps
+//     back (a clock being set) pass through. The date bytes are not used (the RTC of a module
+//     without GPS is often never set). Impossible times (hour > 23, minute > 59, second > 60,
+//     ms > 999) are malformed and clear the time.
+//   - The decoder never remaps axes: the WT901 datasheet draws X right / Y forward / Z up, the
+//     WT901BLECL one X forward / Y left / Z up; samples are in the module's own axes, world
+//     frame east-north-up ("northeast sky") with yaw relative to the module's reference.
+//   - Every valid frame lands in exactly one of: a sample, ignored_frames, malformed. Bytes not
+//     part of a valid frame are skipped_bytes; each run of them is one resync. A frame whose
+//     checksum fails counts in bad_checksum, and the search resumes at its second byte (so a
+//     good frame starting inside it is still found).
+#include "posefair/drivers/witmotion_decoder.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "posefair/drivers/byte_order.hpp"
+#include "posefair/drivers/checksums.hpp"
+#include "posefair/drivers/euler_angles.hpp"
+
+namespace posefair::drivers {
+namespace {
+
+constexpr std::uint8_t kHeader = 0x55;
+constexpr std::size_t kFrameSize = kWitMotionFrameSize;
+constexpr std::uint8_t kTypeTime = 0x50;
+constexpr std::uint8_t kTypeAngles = 0x53;
+constexpr std::uint8_t kTypeQuaternion = 0x59;
+constexpr double kQuatScale = 1.0 / 32768.0;
+constexpr double kAngleScale = 180.0 / 32768.0;
+constexpr std::int64_t kDayMs = 86'400'000;
+
+bool is_frame_type(std::uint8_t type) { return (type & 0xF0u) == 0x50u; }
+
+std::int16_t saturate_i16(double v) {
+  const double r = std::round(v);
+  if (!(r >= -32768.0)) return -32768;  // also NaN
+  if (r > 32767.0) return 32767;
+  return static_cast<std::int16_t>(r);
+}
+
+std::uint16_t wrap_i16(double v) {
+  if (!std::isfinite(v)) return 0;
+  const double r = std::round(std::fmod(v, 65536.0));
+  return static_cast<std::uint16_t>(static_cast<std::int32_t>(r) & 0xFFFF);
+}
+
+class WitMotionDecoder final : public Decoder {
+ public:
+  explicit WitMotionDecoder(bool scalar_first) : scalar_first_(scalar_first) {}
+
+  std::string_view protocol() const override { return "witmotion"; }
+
+  void feed(std::span<const std::uint8_t> in, DecodedSink& sink) override {
+    counters_.bytes += in.size();
+    std::size_t off = 0;
+    if (carry_len_ > 0) {
+      // Decide the positions that start in the carried bytes, with enough input appended to
+      // complete any frame starting there.
+      std::array<std::uint8_t, 2 * kFrameSize> joined{};
+      const std::size_t head = std::min(in.size(), kFrameSize - 1);
+      std::memcpy(joined.data(), carry_.data(), carry_len_);
+      if (head > 0) std::memcpy(joined.data() + carry_len_, in.data(), head);
+      const std::size_t n = carry_len_ + head;
+      const std::size_t pos = scan(joined.data(), n, carry_len_, sink);
+      if (pos < carry_len_) {  // still short of a whole frame: all of `in` is in `joined`
+        carry_len_ = n - pos;
+        std::memmove(carry_.data(), joined.data() + pos, carry_len_);
+        return;
+      }
+      off = pos - carry_len_;
+      carry_len_ = 0;
+    }
+    const std::size_t rest = in.size() - off;
+    const std::size_t pos = scan(in.data() + off, rest, rest, sink);
+    carry_len_ = rest - pos;
+    if (carry_len_ > 0) std::memcpy(carry_.data(), in.data() + off + pos, carry_len_);
+  }
+
+  void reset() override {
+    carry_len_ = 0;
+    in_resync_ = false;
+    quaternion_seen_ = false;
+    angles_since_quaternion_ = 0;
+    time_valid_ = false;
+    have_time_of_day_ = false;
+    last_time_of_day_ms_ = 0;
+    day_offset_ms_ = 0;
+    cycle_types_ = 0;
+  }
+
+ private:
+  // Decides the stream positions p[0], p[1], ... while they are < limit; returns the position
+  // it stopped at: >= limit, or < limit where a frame starts that needs bytes beyond p[n-1].
+  std::size_t scan(const std::uint8_t* p, std::size_t n, std::size_t limit, DecodedSink& sink) {
+    std::size_t pos = 0;
+    while (pos < limit) {
+      if (p[pos] != kHeader) {
+        const void* hit = std::memchr(p + pos, kHeader, limit - pos);
+        const std::size_t next = hit ? static_cast<std::size_t>(static_cast<const std::uint8_t*>(hit) - p) : limit;
+        skip(next - pos);
+        pos = next;
+        continue;
+      }
+      if (n - pos < kFrameSize) break;
+      const std::uint8_t* f = p + pos;
+      if (!is_frame_type(f[1])) {
+        skip(1);
+        ++pos;
+        continue;
+      }
+      if (checksum::sum8({f, kFrameSize - 1}) != f[kFrameSize - 1]) {
+        ++counters_.bad_checksum;
+        skip(1);
+        ++pos;
+        continue;
+      }
+      in_resync_ = false;
+      accept(f, sink);
+      pos += kFrameSize;
+    }
+    return pos;
+  }
+
+  void skip(std::size_t n) {
+    if (n == 0) return;
+    if (!in_resync_) {
+      in_resync_ = true;
+      ++counters_.resyncs;
+    }
+    counters_.skipped_bytes += n;
+  }
+
+  void accept(const std::uint8_t* f, DecodedSink& sink) {
+    ++counters_.frames;
+    const std::uint8_t type = f[1];
+    const std::uint8_t* d = f + 2;
+    const auto bit = static_cast<std::uint16_t>(1u << (type & 0x0Fu));
+    if (type == kTypeTime) {
+      cycle_types_ = bit;
+      on_time(d);
+      return;
+    }
+    if ((cycle_types_ & bit) != 0) {  // a new cycle began without its time frame
+      time_valid_ = false;
+      cycle_types_ = 0;
+    }
+    cycle_types_ = static_cast<std::uint16_t>(cycle_types_ | bit);
+    switch (type) {
+      case kTypeQuaternion: on_quaternion(d, sink); break;
+      case kTypeAngles: on_angles(d, sink); break;
+      default: ++counters_.ignored_frames; break;
+    }
+  }
+
+  void on_time(const std::uint8_t* d) {
+    const int hour = d[3], minute = d[4], second = d[5];
+    const int ms = bytes::le_u16(d + 6);
+    if (hour > 23 || minute > 59 || second > 60 || ms > 999) {
+      ++counters_.malformed;
+      time_valid_ = false;
+      return;
+    }
+    ++counters_.ignored_frames;  // a valid frame without an orientation
+    const std::int64_t tod = ((static_cast<std::int64_t>(hour) * 60 + minute) * 60 + second) * 1000 + ms;
+    if (have_time_of_day_ && tod < last_time_of_day_ms_ - kDayMs / 2) day_offset_ms_ += kDayMs;
+    have_time_of_day_ = true;
+    last_time_of_day_ms_ = tod;
+    time_ = static_cast<double>(day_offset_ms_ + tod) / 1000.0;
+    time_valid_ = true;
+  }
+
+  void on_quaternion(const std::uint8_t* d, DecodedSink& sink) {
+    const double c0 = bytes::le_i16(d) * kQuatScale;
+    const double c1 = bytes::le_i16(d + 2) * kQuatScale;
+    const double c2 = bytes::le_i16(d + 4) * kQuatScale;
+    const double c3 = bytes::le_i16(d + 6) * kQuatScale;
+    Quat q = scalar_first_ ? Quat(c0, c1, c2, c3) : Quat(c3, c0, c1, c2);
+    const double norm = q.norm();
+    if (!(norm >= 0.9 && norm <= 1.1)) {
+      ++counters_.malformed;
+      return;
+    }
+    quaternion_seen_ = true;
+    angles_since_quaternion_ = 0;
+    q.coeffs() /= norm;
+    emit(q, sink);
+  }
+
+  void on_angles(const std::uint8_t* d, DecodedSink& sink) {
+    if (quaternion_seen_ && ++angles_since_quaternion_ < 2) {
+      ++counters_.ignored_frames;  // the 0x59 of this cycle carries the orientation
+      return;
+    }
+    quaternion_seen_ = false;
+    angles_since_quaternion_ = 0;
+    const std::int16_t pitch_raw = bytes::le_i16(d + 2);
+    if (pitch_raw > 16384 || pitch_raw < -16384) {
+      ++counters_.malformed;
+      return;
+    }
+    static constexpr std::array<Axis, 3> kZYX = {Axis::Z, Axis::Y, Axis::X};
+    const std::array<double, 3> deg = {bytes::le_i16(d + 4) * kAngleScale, pitch_raw * kAngleScale,
+                                       bytes::le_i16(d) * kAngleScale};
+    emit(euler_to_quat(kZYX, deg), sink);
+  }
+
+  void emit(const Quat& q, DecodedSink& sink) {
+    DecodedSample s;
+    s.orientation = q;
+    if (time_valid_) {
+      s.flags |= kHasDeviceTime;
+      s.device_time = time_;
+    }
+    ++counters_.samples;
+    sink.on_sample(s);
+  }
+
+  const bool scalar_first_;
+  std::array<std::uint8_t, kFrameSize> carry_{};
+  std::size_t carry_len_ = 0;
+  bool in_resync_ = false;
+  bool quaternion_seen_ = false;
+  int angles_since_quaternion_ = 0;
+  bool time_valid_ = false;
+  double time_ = 0.0;
+  bool have_time_of_day_ = false;
+  std::int64_t last_time_of_day_ms_ = 0;
+  std::int64_t day_offset_ms_ = 0;
+  std::uint16_t cycle_types_ = 0;  // bit (type & 15) for each packet type seen since the last 0x50
+};
+
+}  // namespace
+
+std::unique_ptr<Decoder> make_witmotion_decoder(const DecoderOptions& options) {
+  if (options.witmotion_scalar == "first") return std::make_unique<WitMotionDecoder>(true);
+  if (options.witmotion_scalar == "last") return std::make_unique<WitMotionDecoder>(false);
+  throw std::invalid_argument("witmotion_scalar must be \"first\" or \"last\", not \"" + options.witmotion_scalar +
+                              "\"");
+}
+
+std::array<std::uint8_t, kWitMotionFrameSize> encode_witmotion_frame(std::uint8_t type,
+                                                                     const std::array<std::uint8_t, 8>& data) {
+  std::array<std::uint8_t, kWitMotionFrameSize> f{};
+  f[0] = kHeader;
+  f[1] = type;
+  std::copy(data.begin(), data.end(), f.begin() + 2);
+  f[10] = checksum::sum8({f.data(), 10});
+  return f;
+}
+
+std::array<std::uint8_t, kWitMotionFrameSize> encode_witmotion_quaternion(const Quat& q, bool scalar_first) {
+  const std::array<double, 4> c = scalar_first ? std::array<double, 4>{q.w(), q.x(), q.y(), q.z()}
+                                               : std::array<double, 4>{q.x(), q.y(), q.z(), q.w()};
+  std::array<std::uint8_t, 8> data{};
+  for (std::size_t i = 0; i < 4; ++i)
+    bytes::put_le_u16(data.data() + 2 * i, static_cast<std::uint16_t>(saturate_i16(c[i] * 32768.0)));
+  return encode_witmotion_frame(kTypeQuaternion, data);
+}
+
+std::array<std::uint8_t, kWitMotionFrameSize> encode_witmotion_angles(double roll_deg, double pitch_deg, double yaw_deg,
+                                                                      std::uint16_t version) {
+  std::array<std::uint8_t, 8> data{};
+  bytes::put_le_u16(data.data(), wrap_i16(roll_deg / kAngleScale));
+  bytes::put_le_u16(data.data() + 2, wrap_i16(pitch_deg / kAngleScale));
+  bytes::put_le_u16(data.data() + 4, wrap_i16(yaw_deg / kAngleScale));
+  bytes::put_le_u16(data.data() + 6, version);
+  return encode_witmotion_frame(kTypeAngles, data);
+}
+
+std::array<std::uint8_t, kWitMotionFrameSize> encode_witmotion_time(int yy, int month, int day, int hour, int minute,
+                                                                    int second, int millisecond) {
+  std::array<std::uint8_t, 8> data{};
+  data[0] = static_cast<std::uint8_t>(yy);
+  data[1] = static_cast<std::uint8_t>(month);
+  data[2] = static_cast<std::uint8_t>(day);
+  data[3] = static_cast<std::uint8_t>(hour);
+  data[4] = static_cast<std::uint8_t>(minute);
+  data[5] = static_cast<std::uint8_t>(second);
+  bytes::put_le_u16(data.data() + 6, static_cast<std::uint16_t>(millisecond));
+  return encode_witmotion_frame(kTypeTime, data);
+}
+
+}  // namespace posefair::drivers

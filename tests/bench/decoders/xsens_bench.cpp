@@ -1,0 +1,69 @@
+// Decoding throughput of the Xsens MTData2 decoder (drivers/src/xsens_decoder.cpp): MB/s of a
+// realistic stream, MTData2 messages with PacketCounter, SampleTimeFine and a float32
+// quaternion (36 bytes each) along smooth random motion (core/synthetic_motion.hpp), with
+// about 1% of the bytes replaced by random ones. Fed in pieces of 64 bytes (what a serial read
+// typically returns) or 4096. Goal: at least 50 MB/s on one core.
+// Run: build/tests/bench/xsens_bench
+#include <benchmark/benchmark.h>
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "posefair/core/synthetic_motion.hpp"
+#include "posefair/drivers/xsens_decoder.hpp"
+
+namespace posefair::drivers {
+namespace {
+
+std::vector<std::uint8_t> make_stream() {
+  SyntheticMotionSpec spec;
+  spec.samples = 40000;
+  spec.sample_rate_hz = 400.0;
+  spec.cycles = 20.0;
+  spec.rotation_noise = 0.01;
+  spec.with_position = false;
+  const SyntheticMotion motion = make_synthetic_motion(spec);
+  std::vector<std::uint8_t> stream;
+  for (std::size_t k = 0; k < motion.noisy.size(); ++k) {
+    const std::vector<std::uint8_t> m = encode_xsens_mtdata2(
+        motion.noisy.orientation[k], static_cast<std::uint16_t>(k), static_cast<std::uint32_t>(25 * k));
+    stream.insert(stream.end(), m.begin(), m.end());
+  }
+  std::mt19937_64 rng(1);
+  std::uniform_int_distribution<int> pct(0, 99);
+  for (std::uint8_t& b : stream)
+    if (pct(rng) == 0) b = static_cast<std::uint8_t>(rng());
+  return stream;
+}
+
+struct CountingSink : DecodedSink {
+  std::uint64_t samples = 0;
+  double sum = 0.0;
+  void on_sample(const DecodedSample& s) override {
+    ++samples;
+    sum += s.orientation.w();
+  }
+};
+
+void BM_XsensDecode(benchmark::State& state) {
+  static const std::vector<std::uint8_t> stream = make_stream();
+  const auto chunk = static_cast<std::size_t>(state.range(0));
+  auto decoder = make_xsens_decoder();
+  CountingSink sink;
+  for (auto _ : state) {
+    for (std::size_t pos = 0; pos < stream.size(); pos += chunk)
+      decoder->feed({stream.data() + pos, std::min(chunk, stream.size() - pos)}, sink);
+    benchmark::DoNotOptimize(sink.sum);
+  }
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * stream.size()));
+  const DecoderCounters& c = decoder->counters();
+  state.counters["samples_per_MB"] = static_cast<double>(c.samples) / (static_cast<double>(c.bytes) / 1e6);
+  state.counters["bad_checksum_pct"] = 100.0 * static_cast<double>(c.bad_checksum) / static_cast<double>(c.bad_checksum + c.frames);
+}
+BENCHMARK(BM_XsensDecode)->Arg(64)->Arg(4096);
+
+}  // namespace
+}  // namespace posefair::drivers
+
+BENCHMARK_MAIN();
