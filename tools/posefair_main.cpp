@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bench_quality_command.hpp"
+#include "devices_command.hpp"
 #include "exit_codes.hpp"
 #include "fair_command.hpp"
 #include "reproduce_command.hpp"
@@ -16,6 +17,7 @@ int main(int argc, char** argv) {
   posefair::tools::add_reproduce_command(app, exit_code);
   posefair::tools::add_bench_command(app, exit_code);
   posefair::tools::add_sub_command(app, exit_code);
+  posefair::tools::add_devices_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -18,6 +18,7 @@ packages=(
   systemd                # systemd-analyze verify checks config/posefaird.service
   python3                # the Python subscriber client and its test
   zlib1g-dev             # CRC-32 of the sample log (drivers)
+  libserialport-dev      # the serial driver: ports by path or USB id, settings (drivers)
 )
 if [[ "${1:-}" == "--plots" ]]; then
   packages+=(python3 python3-matplotlib python3-numpy)

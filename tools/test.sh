@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds everything and runs the whole test suite with ctest: once in Release, once under
 # AddressSanitizer + UndefinedBehaviorSanitizer, and the tests where threads meet (the rings,
-# the replay driver, the daemon pipeline, posefaird end to end) under ThreadSanitizer.
+# the replay and serial drivers, the daemon pipeline, posefaird end to end) under ThreadSanitizer.
 # Installs missing Debian packages first.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,7 +20,8 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
 
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPOSEFAIR_SANITIZE_THREAD=ON \
   -DPOSEFAIR_BUILD_BENCHMARKS=OFF >/dev/null
-threaded=(tests/daemon/ring_tests tests/daemon/pipeline_tests tests/daemon/daemon_e2e_tests tests/replaylog/replaylog_tests)
+threaded=(tests/daemon/ring_tests tests/daemon/pipeline_tests tests/daemon/daemon_e2e_tests tests/replaylog/replaylog_tests
+          tests/drivers/serial_tests)
 cmake --build build-tsan -j "$jobs" --target posefaird posefair "${threaded[@]##*/}"
 # Each binary runs whole (ctest's per-test labels cannot carry a list through gtest discovery).
 for t in "${threaded[@]}"; do

@@ -20,6 +20,7 @@
 
 #include "posefair/core/sample_gate.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
+#include "posefair/drivers/decoder.hpp"
 #include "posefair/drivers/pose_file.hpp"
 
 namespace posefair::daemon {
@@ -131,6 +132,37 @@ constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "over
 constexpr std::string_view kReplayKeys[] = {"type",   "path",   "timing",     "speed",        "schedule",     "loop",
                                             "rounds", "format", "joint",      "csv_prefix",   "skip_missing", "source_stream"};
 constexpr std::string_view kSyntheticKeys[] = {"type", "rate_hz", "duration", "rotation_noise", "with_position", "seed", "phase"};
+constexpr std::string_view kSerialKeys[] = {"type",         "device",   "usb",           "serial_number",
+                                            "baud",         "data_bits", "parity",       "stop_bits",
+                                            "flow_control", "protocol", "witmotion_scalar", "time_source",
+                                            "reconnect_min", "reconnect_max", "vectornav_unchecked", "yost_header",
+                                            "yost_data_length"};
+
+// Decoder options (drivers::DecoderOptions), each valid with one protocol only. The decoder
+// judges the value itself (make_decoder throws std::invalid_argument for a bad one).
+struct ProtocolOption {
+  std::string_view key;
+  std::string_view protocol;
+  std::string drivers::DecoderOptions::*field;
+};
+const ProtocolOption kProtocolOptions[] = {
+    {"witmotion_scalar", "witmotion", &drivers::DecoderOptions::witmotion_scalar},
+    {"vectornav_unchecked", "vectornav", &drivers::DecoderOptions::vectornav_unchecked},
+    {"yost_header", "yost", &drivers::DecoderOptions::yost_header},
+    {"yost_data_length", "yost", &drivers::DecoderOptions::yost_data_length},
+};
+
+// Each [stream.driver] type and its keys.
+struct DriverKind {
+  DriverType type;
+  std::string_view name;
+  std::span<const std::string_view> keys;
+};
+const DriverKind kDriverKinds[] = {
+    {DriverType::Replay, "replay", kReplayKeys},
+    {DriverType::Synthetic, "synthetic", kSyntheticKeys},
+    {DriverType::Serial, "serial", kSerialKeys},
+};
 constexpr std::string_view kOutputKeys[] = {"encoding", "destinations", "ttl",          "interface",
                                             "loopback", "streams",      "angular_velocity"};
 constexpr std::string_view kRecorderKeys[] = {"path",  "enabled", "max_file_bytes", "flush_interval",
@@ -545,27 +577,135 @@ class Parser {
     return c;
   }
 
+  // [stream.driver] with type = "serial". The device is not opened (nor required to exist):
+  // the driver waits for it.
+  void parse_serial(const toml::table& t, const std::string& prefix, SerialSourceConfig& c) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    const toml::node* device = t.get("device");
+    const toml::node* usb = t.get("usb");
+    if (device != nullptr && usb != nullptr)
+      fail(*usb, key("usb"), "give either device or usb, not both (device is set at line " +
+                                 std::to_string(device->source().begin.line) + ")");
+    if (device == nullptr && usb == nullptr)
+      fail(t.source().begin, key("device"), "missing required key: device (a path) or usb (\"VID:PID\")");
+    if (device != nullptr) {
+      const std::string path = get_nonempty_string(*device, key("device"));
+      if (!std::filesystem::path(path).is_absolute())
+        fail(*device, key("device"), "must be an absolute path, e.g. '/dev/ttyUSB0' or '/dev/serial/by-id/...', got " + in_quotes(path));
+      c.port.device = path;
+    }
+    if (usb != nullptr) {
+      const std::string text = get_string(*usb, key("usb"));
+      c.port.usb = drivers::parse_usb_id(text);
+      if (!c.port.usb)
+        fail(*usb, key("usb"), "not a USB id: " + in_quotes(text) + "; expected VID:PID in hexadecimal, e.g. '1a86:7523'");
+    }
+    if (const toml::node* n = t.get("serial_number")) {
+      if (usb == nullptr) fail(*n, key("serial_number"), "only with usb (it selects among devices of one USB id)");
+      c.port.usb_serial = get_nonempty_string(*n, key("serial_number"));
+    }
+
+    drivers::SerialSettings& st = c.settings;
+    if (const toml::node* n = t.get("baud")) st.baud = static_cast<int>(get_int(*n, key("baud"), 50, 12000000));
+    if (const toml::node* n = t.get("data_bits")) st.data_bits = static_cast<int>(get_int(*n, key("data_bits"), 5, 8));
+    if (const toml::node* n = t.get("parity"))
+      st.parity = get_choice<drivers::Parity>(*n, key("parity"),
+                                              {{"none", drivers::Parity::None}, {"odd", drivers::Parity::Odd},
+                                               {"even", drivers::Parity::Even}, {"mark", drivers::Parity::Mark},
+                                               {"space", drivers::Parity::Space}});
+    if (const toml::node* n = t.get("stop_bits")) {
+      if (!n->is_integer()) wrong_type(*n, key("stop_bits"), "an integer");
+      const std::int64_t v = n->as_integer()->get();
+      if (v != 1 && v != 2) fail(*n, key("stop_bits"), "must be 1 or 2, got " + std::to_string(v));
+      st.stop_bits = static_cast<int>(v);
+    }
+    if (const toml::node* n = t.get("flow_control"); n != nullptr && n->value<std::string>() == std::string("dtrdsr"))
+      fail(*n, key("flow_control"), "Linux has no DTR/DSR flow control (use none, xonxoff or rtscts)");
+    if (const toml::node* n = t.get("flow_control"))
+      st.flow_control = get_choice<drivers::FlowControl>(
+          *n, key("flow_control"),
+          {{"none", drivers::FlowControl::None}, {"xonxoff", drivers::FlowControl::XonXoff},
+           {"rtscts", drivers::FlowControl::RtsCts}, {"dtrdsr", drivers::FlowControl::DtrDsr}});
+
+    const toml::node& protocol_node = require(t, "protocol", prefix);
+    c.protocol = get_nonempty_string(protocol_node, key("protocol"));
+    const toml::node* option_node = nullptr;  // the first decoder option given, for errors
+    std::string option_key;
+    for (const ProtocolOption& po : kProtocolOptions) {
+      const toml::node* n = t.get(po.key);
+      if (n == nullptr) continue;
+      if (c.protocol != po.protocol)
+        fail(*n, key(po.key), "only for protocol " + in_quotes(std::string(po.protocol)) +
+                                               " (this source's protocol is " + in_quotes(c.protocol) + ")");
+      // Numbers are welcome where the decoder reads a number (yost_header = 0x4F, yost_data_length = 16).
+      c.decoder.*po.field = n->is_integer() ? std::to_string(n->as_integer()->get()) : get_nonempty_string(*n, key(po.key));
+      if (option_node == nullptr) {
+        option_node = n;
+        option_key = key(po.key);
+      }
+    }
+    if (const toml::node* n = t.get("time_source"))
+      c.time_source = get_choice<drivers::TimeSource>(*n, key("time_source"),
+                                                      {{"auto", drivers::TimeSource::Auto},
+                                                       {"receive", drivers::TimeSource::Receive},
+                                                       {"device", drivers::TimeSource::Device}});
+    const toml::node* min_node = t.get("reconnect_min");
+    const toml::node* max_node = t.get("reconnect_max");
+    if (min_node != nullptr) c.reconnect_min = get_float(*min_node, key("reconnect_min"), FloatRange{0.0, true, 60.0, false});
+    if (max_node != nullptr) c.reconnect_max = get_float(*max_node, key("reconnect_max"), FloatRange{0.0, true, 3600.0, false});
+    if (c.reconnect_max < c.reconnect_min) {
+      if (max_node != nullptr)
+        fail(*max_node, key("reconnect_max"), "must be >= reconnect_min (" + number(c.reconnect_min) + " s), got " + number(c.reconnect_max));
+      fail(*min_node, key("reconnect_min"), "must be <= reconnect_max (" + number(c.reconnect_max) + " s, the default), got " + number(c.reconnect_min));
+    }
+
+    // Last, so that every other key is judged the same whichever decoders this build has.
+    const std::vector<std::string> known = drivers::decoder_protocols();
+    if (std::find(known.begin(), known.end(), c.protocol) == known.end()) {
+      std::string list;
+      for (const std::string& p : known) list += (list.empty() ? "" : ", ") + p;
+      const std::vector<std::string_view> names(known.begin(), known.end());
+      fail(protocol_node, key("protocol"),
+           "unknown protocol " + in_quotes(c.protocol) + " (known: " + (list.empty() ? "none" : list) + ")" +
+               suggestion(c.protocol, names));
+    }
+    try {
+      (void)drivers::make_decoder(c.protocol, c.decoder);  // the decoder judges its own options
+    } catch (const std::invalid_argument& e) {
+      if (option_node != nullptr) fail(*option_node, option_key, e.what());
+      fail(protocol_node, key("protocol"), e.what());
+    }
+  }
+
   // [stream.driver]; returns a synthetic driver's rate (the engine's default rate_hz).
   std::optional<Given<double>> parse_driver(const toml::table& t, const std::string& prefix, StreamConfig& s) const {
     const std::string type_key = join_key(prefix, "type");
     const toml::node& type_node = require(t, "type", prefix);
-    s.driver.type = get_choice<DriverType>(type_node, type_key, {{"replay", DriverType::Replay}, {"synthetic", DriverType::Synthetic}});
-    const bool replay = s.driver.type == DriverType::Replay;
-    const std::span<const std::string_view> own = replay ? std::span<const std::string_view>(kReplayKeys) : std::span<const std::string_view>(kSyntheticKeys);
-    const std::span<const std::string_view> other = replay ? std::span<const std::string_view>(kSyntheticKeys) : std::span<const std::string_view>(kReplayKeys);
-    const char* own_name = replay ? "replay" : "synthetic";
-    const char* other_name = replay ? "synthetic" : "replay";
+    s.driver.type = get_choice<DriverType>(
+        type_node, type_key,
+        {{"replay", DriverType::Replay}, {"synthetic", DriverType::Synthetic}, {"serial", DriverType::Serial}});
+    const DriverKind* own = &kDriverKinds[0];
+    for (const DriverKind& k : kDriverKinds)
+      if (k.type == s.driver.type) own = &k;
     const toml::key* first = nullptr;
     for (auto&& [k, v] : t) {
-      if (std::find(own.begin(), own.end(), k.str()) != own.end()) continue;
+      if (std::find(own->keys.begin(), own->keys.end(), k.str()) != own->keys.end()) continue;
       if (first == nullptr || before(k.source().begin, first->source().begin)) first = &k;
     }
     if (first != nullptr) {
       const std::string key = join_key(prefix, first->str());
-      if (std::find(other.begin(), other.end(), first->str()) != other.end())
-        fail(first->source().begin, key, std::string("unknown key for driver type ") + own_name + " (it belongs to type " + other_name + ")");
-      fail(first->source().begin, key, std::string("unknown key for driver type ") + own_name + suggestion(first->str(), own));
+      const std::string unknown = "unknown key for driver type " + std::string(own->name);
+      for (const DriverKind& other : kDriverKinds) {
+        if (std::find(other.keys.begin(), other.keys.end(), first->str()) != other.keys.end())
+          fail(first->source().begin, key, unknown + " (it belongs to type " + std::string(other.name) + ")");
+      }
+      fail(first->source().begin, key, unknown + suggestion(first->str(), own->keys));
     }
+    if (s.driver.type == DriverType::Serial) {
+      parse_serial(t, prefix, s.driver.serial);
+      return std::nullopt;
+    }
+    const bool replay = s.driver.type == DriverType::Replay;
     auto key = [&](std::string_view name) { return join_key(prefix, name); };
 
     if (replay) {

@@ -1,9 +1,12 @@
 #include "posefair/daemon/driver_factory.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <stdexcept>
 #include <utility>
 
 #include "posefair/drivers/replay_driver.hpp"
+#include "posefair/drivers/serial_driver.hpp"
 #include "posefair/drivers/synthetic_driver.hpp"
 
 namespace posefair::daemon {
@@ -71,6 +74,44 @@ MadeDriver make_synthetic(const StreamConfig& stream) {
   return made;
 }
 
+// A device driver's state changes (opened, lost, reopened) go to the daemon's log, from the
+// driver's thread: a few lines per connection, never per sample.
+drivers::DriverLog to_spdlog(const std::string& stream_name) {
+  return [prefix = "stream '" + stream_name + "': "](drivers::LogLevel level, std::string_view message) {
+    spdlog::level::level_enum l = spdlog::level::info;
+    switch (level) {
+      case drivers::LogLevel::Debug: l = spdlog::level::debug; break;
+      case drivers::LogLevel::Info: l = spdlog::level::info; break;
+      case drivers::LogLevel::Warn: l = spdlog::level::warn; break;
+      case drivers::LogLevel::Error: l = spdlog::level::err; break;
+    }
+    spdlog::log(l, "{}{}", prefix, message);
+  };
+}
+
+MadeDriver make_serial(const StreamConfig& stream) {
+  const SerialSourceConfig& sc = stream.driver.serial;
+  drivers::SerialDriverOptions o;
+  o.port = sc.port;
+  o.settings = sc.settings;
+  o.protocol = sc.protocol;
+  o.decoder_options = sc.decoder;
+  o.stream_id = stream.id;
+  o.reconnect_min = sc.reconnect_min;
+  o.reconnect_max = sc.reconnect_max;
+  o.time_source = sc.time_source;
+  o.log = to_spdlog(stream.name);
+  MadeDriver made;
+  made.source = "serial:" + sc.port.describe() + " (" + sc.protocol + ")";
+  o.name = made.source;
+  try {
+    made.driver = std::make_unique<drivers::SerialDriver>(std::move(o));
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("stream '" + stream.name + "': " + e.what());
+  }
+  return made;
+}
+
 }  // namespace
 
 MadeDriver make_driver(const StreamConfig& stream) {
@@ -79,6 +120,8 @@ MadeDriver make_driver(const StreamConfig& stream) {
       return make_replay(stream);
     case DriverType::Synthetic:
       return make_synthetic(stream);
+    case DriverType::Serial:
+      return make_serial(stream);
   }
   throw std::logic_error("make_driver: unknown driver type");
 }

@@ -1,6 +1,7 @@
 // posefaird's TOML configuration (docs/config.md): every key of a full config lands in its
 // DaemonConfig field, the example configs load, and malformed configs are refused with the
 // file, line and key of the problem.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +14,7 @@
 
 #include "../support/test_files.hpp"
 #include "posefair/daemon/config.hpp"
+#include "posefair/drivers/decoder.hpp"
 #include "posefair/drivers/replay_driver.hpp"
 
 namespace posefair::daemon {
@@ -314,6 +316,104 @@ driver = { type = "synthetic" }
   EXPECT_EQ(e.gate.unit_tolerance, d.gate.unit_tolerance);
 }
 
+TEST(Config, ASerialSourceFillsEveryField) {
+  const std::vector<std::string> protocols = drivers::decoder_protocols();
+  if (protocols.empty())
+    GTEST_SKIP() << "no protocol decoder is registered yet (drivers/src/decoder_registry.cpp); "
+                    "a serial source needs one";
+  const std::string protocol = protocols.front();
+  std::string text = R"toml(
+[[stream]]
+id = 1
+name = "by-usb"
+[stream.driver]
+type = "serial"
+usb = "1A86:7523"
+serial_number = "A50285BI"
+baud = 921600
+data_bits = 7
+parity = "even"
+stop_bits = 2
+flow_control = "rtscts"
+protocol = "@"
+time_source = "device"
+reconnect_min = 0.5
+reconnect_max = 10
+
+[[stream]]
+id = 2
+name = "by-path"
+driver = { type = "serial", device = "/dev/serial/by-id/usb-FTDI_imu-if00-port0", protocol = "@" }
+)toml";
+  for (std::size_t at = text.find('@'); at != std::string::npos; at = text.find('@')) text.replace(at, 1, protocol);
+  const bool witmotion = std::find(protocols.begin(), protocols.end(), "witmotion") != protocols.end();
+  if (witmotion) {
+    text += R"toml(
+[[stream]]
+id = 3
+name = "wit"
+driver = { type = "serial", device = "/dev/ttyUSB1", protocol = "witmotion", witmotion_scalar = "last" }
+)toml";
+  }
+  const DaemonConfig c = parse_config(text, "/nonexistent/serial.toml");
+  ASSERT_EQ(c.streams.size(), witmotion ? 3u : 2u);
+
+  ASSERT_EQ(c.streams[0].driver.type, DriverType::Serial);
+  const SerialSourceConfig& a = c.streams[0].driver.serial;
+  EXPECT_TRUE(a.port.device.empty());
+  ASSERT_TRUE(a.port.usb.has_value());
+  EXPECT_EQ(a.port.usb->vid, 0x1a86);
+  EXPECT_EQ(a.port.usb->pid, 0x7523);
+  EXPECT_EQ(a.port.usb_serial, "A50285BI");
+  EXPECT_EQ(a.settings.baud, 921600);
+  EXPECT_EQ(a.settings.data_bits, 7);
+  EXPECT_EQ(a.settings.parity, drivers::Parity::Even);
+  EXPECT_EQ(a.settings.stop_bits, 2);
+  EXPECT_EQ(a.settings.flow_control, drivers::FlowControl::RtsCts);
+  EXPECT_EQ(a.protocol, protocol);
+  EXPECT_EQ(a.time_source, drivers::TimeSource::Device);
+  EXPECT_EQ(a.reconnect_min, 0.5);
+  EXPECT_EQ(a.reconnect_max, 10.0);
+
+  // Every default.
+  ASSERT_EQ(c.streams[1].driver.type, DriverType::Serial);
+  const SerialSourceConfig& b = c.streams[1].driver.serial;
+  EXPECT_EQ(b.port.device, "/dev/serial/by-id/usb-FTDI_imu-if00-port0");
+  EXPECT_FALSE(b.port.usb.has_value());
+  EXPECT_EQ(b.port.usb_serial, "");
+  const drivers::SerialSettings d;
+  EXPECT_EQ(b.settings.baud, 115200);
+  EXPECT_EQ(b.settings.data_bits, d.data_bits);
+  EXPECT_EQ(b.settings.parity, drivers::Parity::None);
+  EXPECT_EQ(b.settings.stop_bits, 1);
+  EXPECT_EQ(b.settings.flow_control, drivers::FlowControl::None);
+  EXPECT_EQ(b.time_source, drivers::TimeSource::Auto);
+  EXPECT_EQ(b.reconnect_min, 0.1);
+  EXPECT_EQ(b.reconnect_max, 5.0);
+  EXPECT_EQ(b.decoder.witmotion_scalar, drivers::DecoderOptions{}.witmotion_scalar);
+  // No rate from a serial driver: the engine keeps its defaults.
+  EXPECT_EQ(c.streams[1].engine.window, WindowConfig{}.window);
+
+  if (witmotion) {
+    EXPECT_EQ(c.streams[2].driver.serial.decoder.witmotion_scalar, "last");
+  }
+}
+
+TEST(Config, DecoderOptionsReachTheirDecoderAsTextOrNumber) {
+  const DaemonConfig c = parse_config(R"([[stream]]
+id = 1
+name = "vn"
+driver = { type = "serial", device = "/dev/ttyUSB0", protocol = "vectornav", vectornav_unchecked = "accept" }
+[[stream]]
+id = 2
+name = "yost"
+driver = { type = "serial", device = "/dev/ttyUSB1", protocol = "yost", yost_header = 0x4F, yost_data_length = 16 }
+)", "/virtual/options.toml");
+  EXPECT_EQ(c.streams[0].driver.serial.decoder.vectornav_unchecked, "accept");
+  EXPECT_EQ(c.streams[1].driver.serial.decoder.yost_header, "79");
+  EXPECT_EQ(c.streams[1].driver.serial.decoder.yost_data_length, "16");
+}
+
 TEST(Config, TheMostSpecificTableDecidesTheSmoothing) {
   testing::ScratchDir dir("posefair-config-");
   write_file(dir / "poses.csv", "t,qw,qx,qy,qz\n0,1,0,0,0\n");
@@ -543,8 +643,8 @@ name = "a"
 id = 1
 name = "a"
 [stream.driver]
-type = "serial"
-)", "stream[1].driver.type: expected one of 'replay', 'synthetic', got 'serial'", 5},
+type = "socketcan"
+)", "stream[1].driver.type: expected one of 'replay', 'synthetic', 'serial', got 'socketcan'", 5},
     {"replay key on a synthetic driver", R"([[stream]]
 id = 1
 name = "a"
@@ -707,6 +807,152 @@ id = 1
 name = "a"
 driver = { type = "synthetic" }
 )", "logging.level: expected one of 'trace', 'debug', 'info', 'warn', 'error', 'critical', 'off', got 'warning'", 2},
+    {"serial: unknown protocol", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "serial"
+device = "/dev/ttyUSB0"
+protocol = "nope"
+)", "stream[1].driver.protocol: unknown protocol 'nope' (known: ", 7},
+    {"serial: witmotion_scalar with another protocol", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "serial"
+device = "/dev/ttyUSB0"
+protocol = "yost"
+witmotion_scalar = "last"
+)", "stream[1].driver.witmotion_scalar: only for protocol 'witmotion' (this source's protocol is 'yost')", 8},
+    {"serial: vectornav_unchecked with another protocol", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "serial", device = "/dev/ttyUSB0", protocol = "xsens", vectornav_unchecked = "accept" }
+)", "stream[1].driver.vectornav_unchecked: only for protocol 'vectornav' (this source's protocol is 'xsens')", 4},
+    {"serial: a yost header without the checksum bit, judged by the decoder", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "serial"
+device = "/dev/ttyUSB0"
+protocol = "yost"
+yost_header = 1
+)", "stream[1].driver.yost_header: ", 8},
+    {"serial: dtrdsr flow control does not exist on Linux", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "serial"
+device = "/dev/ttyUSB0"
+flow_control = "dtrdsr"
+protocol = "posefair"
+)", "stream[1].driver.flow_control: Linux has no DTR/DSR flow control", 7},
+    {"serial: baud 0", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "serial"
+device = "/dev/ttyUSB0"
+baud = 0
+protocol = "witmotion"
+)", "stream[1].driver.baud: out of range: must be in [50, 12000000], got 0", 7},
+    {"serial: baud as a string", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "serial", device = "/dev/ttyUSB0", baud = "115200", protocol = "witmotion" }
+)", "stream[1].driver.baud: expected an integer, got a string", 4},
+    {"serial: bad usb id", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "serial"
+usb = "1a86-7523"
+protocol = "witmotion"
+)", "stream[1].driver.usb: not a USB id: '1a86-7523'; expected VID:PID in hexadecimal, e.g. '1a86:7523'", 6},
+    {"serial: usb id too long", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "serial", usb = "1a86:75230", protocol = "witmotion" }
+)", "stream[1].driver.usb: not a USB id: '1a86:75230'", 4},
+    {"serial: device and usb", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "serial"
+device = "/dev/ttyUSB0"
+usb = "1a86:7523"
+protocol = "witmotion"
+)", "stream[1].driver.usb: give either device or usb, not both (device is set at line 6)", 7},
+    {"serial: neither device nor usb", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "serial"
+protocol = "witmotion"
+)", "stream[1].driver.device: missing required key: device (a path) or usb (\"VID:PID\")", 4},
+    {"serial: relative device path", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "serial", device = "ttyUSB0", protocol = "witmotion" }
+)", "stream[1].driver.device: must be an absolute path", 4},
+    {"serial: serial_number without usb", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "serial"
+device = "/dev/ttyUSB0"
+serial_number = "A50285BI"
+protocol = "witmotion"
+)", "stream[1].driver.serial_number: only with usb", 7},
+    {"serial: protocol missing", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "serial"
+device = "/dev/ttyUSB0"
+)", "stream[1].driver.protocol: missing required key", 4},
+    {"serial: stop bits 3", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "serial", device = "/dev/ttyUSB0", stop_bits = 3, protocol = "witmotion" }
+)", "stream[1].driver.stop_bits: must be 1 or 2, got 3", 4},
+    {"serial: parity typo", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "serial", device = "/dev/ttyUSB0", parity = "Even", protocol = "witmotion" }
+)", "stream[1].driver.parity: expected one of 'none', 'odd', 'even', 'mark', 'space', got 'Even' (did you mean 'even'?)", 4},
+    {"serial: reconnect_max below reconnect_min", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "serial"
+device = "/dev/ttyUSB0"
+protocol = "witmotion"
+reconnect_min = 2
+reconnect_max = 1
+)", "stream[1].driver.reconnect_max: must be >= reconnect_min (2 s), got 1", 9},
+    {"serial: a synthetic key", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "serial"
+device = "/dev/ttyUSB0"
+rate_hz = 100
+protocol = "witmotion"
+)", "stream[1].driver.rate_hz: unknown key for driver type serial (it belongs to type synthetic)", 7},
+    {"replay: a serial key", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "replay"
+path = "poses.csv"
+baud = 115200
+)", "stream[1].driver.baud: unknown key for driver type replay (it belongs to type serial)", 7},
+    {"serial: time source typo", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "serial", device = "/dev/ttyUSB0", time_source = "devise", protocol = "witmotion" }
+)", "stream[1].driver.time_source: expected one of 'auto', 'receive', 'device', got 'devise' (did you mean 'device'?)", 4},
     {"a table that is not one", R"(daemon = 5
 [[stream]]
 id = 1

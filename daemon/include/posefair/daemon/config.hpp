@@ -17,7 +17,10 @@
 #include "posefair/daemon/overflow_policy.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
+#include "posefair/drivers/decoder.hpp"
 #include "posefair/drivers/replay_driver.hpp"
+#include "posefair/drivers/serial_port.hpp"
+#include "posefair/drivers/time_base.hpp"
 
 namespace posefair::daemon {
 
@@ -82,12 +85,26 @@ struct SyntheticSourceConfig {
   double phase = 0.0;  // [0, 1): the first sample comes this fraction of a period after start
 };
 
-enum class DriverType { Replay, Synthetic };
+// [stream.driver] with type = "serial": a device on a serial port (drivers/serial_driver.hpp),
+// opened by path or by USB id, its bytes decoded by a registered protocol decoder. The device
+// need not exist at load: the driver waits for it (and for its return after an unplug).
+struct SerialSourceConfig {
+  drivers::SerialPortSpec port;       // device (absolute path) or usb (+ serial_number)
+  drivers::SerialSettings settings;   // baud, data_bits, parity, stop_bits, flow_control
+  std::string protocol;               // one of drivers::decoder_protocols()
+  drivers::DecoderOptions decoder;    // witmotion_scalar
+  drivers::TimeSource time_source = drivers::TimeSource::Auto;
+  double reconnect_min = 0.1;         // s
+  double reconnect_max = 5.0;         // s, >= reconnect_min
+};
+
+enum class DriverType { Replay, Synthetic, Serial };
 
 struct DriverConfig {
   DriverType type = DriverType::Replay;
   ReplaySourceConfig replay;        // type == Replay
   SyntheticSourceConfig synthetic;  // type == Synthetic
+  SerialSourceConfig serial;        // type == Serial
 };
 
 struct StreamConfig {
@@ -132,8 +149,8 @@ struct DaemonConfig {
 // Parses and validates a config file. Throws ConfigError (never anything else) for an
 // unreadable file, a TOML syntax error, an unknown key, a value of the wrong type or out of
 // range, a missing required key, duplicate stream ids or names, an output naming an unknown
-// stream, an engine combination posefair::validate refuses, or a replay source that does not
-// exist.
+// stream, an engine combination posefair::validate refuses, a replay source that does not
+// exist, or a serial source naming an unknown protocol.
 DaemonConfig load_config(const std::filesystem::path& file);
 
 // The same from a string (tests); `file` names it in messages and anchors relative paths.
