@@ -27,70 +27,19 @@
 #include "posefair/daemon/udp_socket.hpp"
 
 #include "../support/counting_allocator.hpp"
+#include "udp_collector.hpp"
 
 namespace posefair::daemon {
 namespace {
 
 namespace counting = posefair::testing;
 using namespace std::chrono_literals;
+using testing::UdpCollector;
+using testing::wait_until;
 
 const std::filesystem::path kDemoCsv = std::filesystem::path(POSEFAIR_SOURCE_DIR) / "data/demo/broad-07-excerpt.csv";
 constexpr std::uint64_t kDemoSamples = 2000;
 constexpr std::uint32_t kSession = 0x5eed0a11u;
-
-// The destination of the pipeline's output: a socket of the test's own on 127.0.0.1, drained
-// by a thread so the kernel's receive buffer never fills. Counts the datagrams.
-class Receiver {
- public:
-  Receiver() {
-    ReceiveOptions ro;
-    ro.receive_buffer_bytes = 8 << 20;
-    socket_ = UdpSocket::bind(*Endpoint::parse("127.0.0.1:0"), ro);
-    thread_ = std::thread([this] { loop(); });
-  }
-  ~Receiver() { stop(); }
-  Receiver(const Receiver&) = delete;
-  Receiver& operator=(const Receiver&) = delete;
-
-  std::uint16_t port() const { return socket_.local_endpoint().port(); }
-  std::uint64_t datagrams() const { return datagrams_.load(); }
-
-  // Ends the thread once nothing has arrived for `quiet` (bounded by `limit` overall).
-  void drain(std::chrono::milliseconds quiet = 100ms, std::chrono::milliseconds limit = 5s) {
-    const auto deadline = std::chrono::steady_clock::now() + limit;
-    for (;;) {
-      const std::uint64_t before = datagrams();
-      std::this_thread::sleep_for(quiet);
-      if (datagrams() == before || std::chrono::steady_clock::now() > deadline) break;
-    }
-    stop();
-  }
-
- private:
-  void stop() {
-    stop_.store(true);
-    if (thread_.joinable()) thread_.join();
-  }
-  void loop() {
-    std::vector<std::uint8_t> buffer(65536);
-    while (!stop_.load())
-      if (socket_.receive(buffer, 20ms)) datagrams_.fetch_add(1);
-  }
-
-  UdpSocket socket_;
-  std::thread thread_;
-  std::atomic<bool> stop_{false};
-  std::atomic<std::uint64_t> datagrams_{0};
-};
-
-bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(5ms);
-  }
-  return true;
-}
 
 // One stream (id 1) with the given driver table body and engine keys, and one output to
 // 127.0.0.1:port with the given encoding.
@@ -134,7 +83,7 @@ struct PipelineRun {
 // threads) and reads what each real-time thread allocated.
 PipelineRun run_pipeline(const std::string& driver, const std::string& solver, const std::string& encoding) {
   PipelineRun run;
-  Receiver receiver;
+  UdpCollector receiver;  // the output's destination; its thread claims no counter slot
   const DaemonConfig config =
       parse_config(config_text(receiver.port(), driver, solver, encoding), "/virtual/pipeline-alloc.toml");
   PipelineHooks hooks;
@@ -150,7 +99,7 @@ PipelineRun run_pipeline(const std::string& driver, const std::string& solver, c
   }
   run.threads = counting::counter_slots_claimed();
   for (int i = 0; i < run.threads; ++i) run.allocations.push_back(counting::slot_allocations(i));
-  receiver.drain();
+  receiver.drain(100ms, 5s);
   run.datagrams = receiver.datagrams();
   return run;
 }

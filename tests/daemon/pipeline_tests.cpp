@@ -24,87 +24,18 @@
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
 #include "posefair/drivers/pose_file.hpp"
+#include "udp_collector.hpp"
 
 namespace posefair::daemon {
 namespace {
 
 using namespace std::chrono_literals;
+using testing::UdpCollector;
+using testing::wait_until;
 
 const std::filesystem::path kDemoCsv = std::filesystem::path(POSEFAIR_SOURCE_DIR) / "data/demo/broad-07-excerpt.csv";
 constexpr std::size_t kDemoSamples = 2000;
 constexpr std::uint32_t kSession = 0x5eed0001u;
-
-
-
-// Every datagram that reaches the test's socket, received on a thread of its own from the
-// start, so the kernel's receive buffer never has to hold a whole run.
-class Receiver {
- public:
-  Receiver() {
-    ReceiveOptions ro;
-    ro.receive_buffer_bytes = 8 << 20;
-    socket_ = UdpSocket::bind(*Endpoint::parse("127.0.0.1:0"), ro);
-    thread_ = std::thread([this] { loop(); });
-  }
-  ~Receiver() { stop(); }
-  Receiver(const Receiver&) = delete;
-  Receiver& operator=(const Receiver&) = delete;
-
-  std::uint16_t port() const { return socket_.local_endpoint().port(); }
-
-  // Ends the thread once nothing has arrived for `quiet` (bounded by `limit` overall): the
-  // caller has stopped the pipeline, so whatever is still in flight is in the socket buffer.
-  void drain(std::chrono::milliseconds quiet = 300ms, std::chrono::milliseconds limit = 10s) {
-    const auto deadline = std::chrono::steady_clock::now() + limit;
-    for (;;) {
-      const std::size_t before = count();
-      std::this_thread::sleep_for(quiet);
-      if (count() == before || std::chrono::steady_clock::now() > deadline) break;
-    }
-    stop();
-  }
-
-  std::vector<PoseMessage> messages() const {
-    std::lock_guard lock(mutex_);
-    return messages_;
-  }
-  std::size_t malformed() const {
-    std::lock_guard lock(mutex_);
-    return malformed_;
-  }
-
- private:
-  std::size_t count() const {
-    std::lock_guard lock(mutex_);
-    return messages_.size() + malformed_;
-  }
-  void stop() {
-    stop_.store(true);
-    if (thread_.joinable()) thread_.join();
-  }
-  void loop() {
-    std::vector<std::uint8_t> buffer(kMaxDatagramSize + 1);
-    while (!stop_.load()) {
-      const auto d = socket_.receive(buffer, 20ms);
-      if (!d) continue;
-      const DecodeResult r =
-          d->truncated ? rejected(DecodeError::kOversized, WireEncoding::kBinary)
-                       : decode_datagram(std::span<const std::uint8_t>(buffer.data(), d->size));
-      std::lock_guard lock(mutex_);
-      if (r.ok())
-        messages_.push_back(r.message);
-      else
-        ++malformed_;
-    }
-  }
-
-  UdpSocket socket_;
-  std::thread thread_;
-  std::atomic<bool> stop_{false};
-  mutable std::mutex mutex_;
-  std::vector<PoseMessage> messages_;
-  std::size_t malformed_ = 0;
-};
 
 // One replayed stream (id 1, the demo CSV, by default as fast as possible) to 127.0.0.1:port.
 std::string replay_config(std::uint16_t port, std::uint32_t ring_capacity, const std::string& overflow,
@@ -141,15 +72,6 @@ std::vector<double> demo_times() {
   return f.poses().time;
 }
 
-bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(5ms);
-  }
-  return true;
-}
-
 struct SlowRun {
   StreamStats stats;
   std::uint64_t hook_calls = 0;
@@ -161,7 +83,7 @@ struct SlowRun {
 // sample, then stops the pipeline and collects what arrived.
 SlowRun run_slow_consumer(const std::string& overflow) {
   SlowRun run;
-  Receiver receiver;
+  UdpCollector receiver;
   const DaemonConfig config = parse_config(replay_config(receiver.port(), 8, overflow), "/virtual/slow.toml");
   std::atomic<std::uint64_t> calls{0};
   PipelineHooks hooks;
@@ -254,7 +176,7 @@ void check_publishing(const SlowRun& run) {
 // The recording itself goes through the pipeline whole when nothing is in the way: the
 // baseline the slow-consumer tests below deviate from.
 TEST(Pipeline, ReplayWithALargeRingLosesNothing) {
-  Receiver receiver;
+  UdpCollector receiver;
   const DaemonConfig config = parse_config(replay_config(receiver.port(), 4096, "drop-oldest"), "/virtual/big.toml");
   StreamStats s;
   {
@@ -322,7 +244,7 @@ TEST(Pipeline, SlowConsumerDropNewestCountsEveryDropAndKeepsTheOldest) {
 // samples (64) before it looks at anything else. The publisher and the network are idle
 // meanwhile: no emitted pose may be lost on its way to them.
 TEST(Pipeline, EveryPoseOfALongEnginePassIsPublished) {
-  Receiver receiver;
+  UdpCollector receiver;
   const DaemonConfig config = parse_config(
       replay_config(receiver.port(), 8, "drop-oldest", "timing = \"original\"\nspeed = 35.0\n"), "/virtual/pass.toml");
   PipelineHooks hooks;
@@ -360,7 +282,7 @@ namespace {
 // the rate is 2 log(q_prev⁻¹ q)/dt of the poses actually sent. A third output that lists only
 // stream 2 gets stream 2 alone.
 TEST(Pipeline, BinaryAndJsonOutputsCarryTheSamePosesAndOutputsHonourTheirStreams) {
-  Receiver binary, json, only_two;
+  UdpCollector binary, json, only_two;
   std::string text = replay_config(binary.port(), 4096, "drop-oldest");
   text += "angular_velocity = true\n";
   text += "\n[[output]]\nencoding = \"json\"\ndestinations = [\"127.0.0.1:" + std::to_string(json.port()) + "\"]\n";

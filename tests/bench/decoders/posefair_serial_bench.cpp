@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "decoder_bench.hpp"
 #include "posefair/core/synthetic_motion.hpp"
 #include "posefair/drivers/checksums.hpp"
 #include "posefair/drivers/posefair_serial_decoder.hpp"
@@ -58,36 +59,15 @@ std::vector<std::uint8_t> make_stream(Form form) {
     }
   }
   std::mt19937_64 rng(1);
-  std::uniform_int_distribution<int> pct(0, 99);
-  for (std::uint8_t& b : stream)
-    if (pct(rng) == 0) b = static_cast<std::uint8_t>(rng());
+  bench::corrupt(stream, 0.01, rng);
   return stream;
 }
-
-struct CountingSink : DecodedSink {
-  std::uint64_t samples = 0;
-  double sum = 0.0;
-  void on_sample(const DecodedSample& s) override {
-    ++samples;
-    sum += s.orientation.w();
-  }
-};
 
 void BM_PosefairSerialDecode(benchmark::State& state) {
   static const std::vector<std::uint8_t> streams[3] = {make_stream(kText), make_stream(kBinary), make_stream(kMixed)};
   const std::vector<std::uint8_t>& stream = streams[state.range(0)];
-  const auto chunk = static_cast<std::size_t>(state.range(1));
   auto decoder = make_posefair_serial_decoder();
-  CountingSink sink;
-  for (auto _ : state) {
-    for (std::size_t pos = 0; pos < stream.size(); pos += chunk)
-      decoder->feed({stream.data() + pos, std::min(chunk, stream.size() - pos)}, sink);
-    benchmark::DoNotOptimize(sink.sum);
-  }
-  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * stream.size()));
-  const DecoderCounters& c = decoder->counters();
-  state.counters["samples_per_MB"] = static_cast<double>(c.samples) / (static_cast<double>(c.bytes) / 1e6);
-  state.counters["bad_checksum_pct"] = 100.0 * static_cast<double>(c.bad_checksum) / static_cast<double>(c.bad_checksum + c.frames);
+  bench::decode_in_reads(state, *decoder, stream, static_cast<std::size_t>(state.range(1)));
   state.SetLabel(state.range(0) == kText ? "text" : state.range(0) == kBinary ? "binary" : "mixed");
 }
 BENCHMARK(BM_PosefairSerialDecode)->ArgsProduct({{kText, kBinary, kMixed}, {64, 4096}});

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "decoder_bench.hpp"
 #include "posefair/core/so3.hpp"
 #include "posefair/drivers/vectornav_decoder.hpp"
 
@@ -19,11 +20,6 @@ namespace posefair::drivers {
 namespace {
 
 enum class Kind { kQmrXor, kQmrCrc, kYmrXor };
-
-struct Counter final : DecodedSink {
-  std::uint64_t n = 0;
-  void on_sample(const DecodedSample&) override { ++n; }
-};
 
 // 20000 sentences of a smooth random motion (angular velocity a random walk), then ~1% of the
 // bytes replaced by random values.
@@ -47,25 +43,14 @@ std::vector<std::uint8_t> stream(Kind kind) {
     }
   }
   std::vector<std::uint8_t> bytes(s.begin(), s.end());
-  std::bernoulli_distribution corrupt(0.01);
-  for (auto& b : bytes)
-    if (corrupt(rng)) b = static_cast<std::uint8_t>(rng());
+  bench::corrupt(bytes, 0.01, rng);
   return bytes;
 }
 
 void BM_VectorNav(benchmark::State& state, Kind kind) {
   const std::vector<std::uint8_t> data = stream(kind);
-  const auto chunk = static_cast<std::size_t>(state.range(0));
   auto decoder = make_vectornav_decoder({});
-  Counter sink;
-  for (auto _ : state) {
-    for (std::size_t at = 0; at < data.size(); at += chunk)
-      decoder->feed({data.data() + at, std::min(chunk, data.size() - at)}, sink);
-    benchmark::DoNotOptimize(sink.n);
-  }
-  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(data.size()));
-  state.counters["samples_per_pass"] = static_cast<double>(sink.n) / static_cast<double>(state.iterations());
-  state.counters["stream_kB"] = static_cast<double>(data.size()) / 1000.0;
+  bench::decode_in_reads(state, *decoder, data, static_cast<std::size_t>(state.range(0)));
 }
 
 BENCHMARK_CAPTURE(BM_VectorNav, vnqmr_xor, Kind::kQmrXor)->Arg(64)->Arg(4096)->Unit(benchmark::kMillisecond);

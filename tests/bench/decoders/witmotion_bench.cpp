@@ -17,6 +17,7 @@
 #include <span>
 #include <vector>
 
+#include "decoder_bench.hpp"
 #include "posefair/drivers/witmotion_decoder.hpp"
 
 namespace posefair::drivers {
@@ -24,15 +25,6 @@ namespace {
 
 using Bytes = std::vector<std::uint8_t>;
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-struct CountingSink : DecodedSink {
-  std::uint64_t n = 0;
-  double sum = 0.0;
-  void on_sample(const DecodedSample& s) override {
-    ++n;
-    sum += s.orientation.w();
-  }
-};
 
 template <std::size_t N>
 void append(Bytes& out, const std::array<std::uint8_t, N>& f) {
@@ -59,25 +51,13 @@ Bytes make_stream(bool with_quaternion, double corrupt_fraction) {
     }
   }
   std::mt19937_64 rng(1);
-  std::uniform_int_distribution<std::size_t> at(0, s.size() - 1);
-  for (std::size_t i = 0; i < static_cast<std::size_t>(corrupt_fraction * static_cast<double>(s.size())); ++i)
-    s[at(rng)] = static_cast<std::uint8_t>(rng());
+  bench::corrupt(s, corrupt_fraction, rng);
   return s;
 }
 
 void run(benchmark::State& state, const Bytes& stream) {
-  const auto chunk = static_cast<std::size_t>(state.range(0));
   auto decoder = make_witmotion_decoder(DecoderOptions{});
-  CountingSink sink;
-  for (auto _ : state) {
-    for (std::size_t at = 0; at < stream.size(); at += chunk)
-      decoder->feed(std::span<const std::uint8_t>(stream.data() + at, std::min(chunk, stream.size() - at)), sink);
-    benchmark::DoNotOptimize(sink.sum);
-  }
-  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * stream.size()));
-  const auto& c = decoder->counters();
-  state.counters["samples/MB"] = static_cast<double>(c.samples) / (static_cast<double>(c.bytes) / 1e6);
-  state.counters["bad_sum%"] = 100.0 * static_cast<double>(c.bad_checksum) / static_cast<double>(c.bad_checksum + c.frames);
+  bench::decode_in_reads(state, *decoder, stream, static_cast<std::size_t>(state.range(0)));
 }
 
 void BM_Mixed(benchmark::State& state) {

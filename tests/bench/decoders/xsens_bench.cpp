@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "decoder_bench.hpp"
 #include "posefair/core/synthetic_motion.hpp"
 #include "posefair/drivers/xsens_decoder.hpp"
 
@@ -31,35 +32,14 @@ std::vector<std::uint8_t> make_stream() {
     stream.insert(stream.end(), m.begin(), m.end());
   }
   std::mt19937_64 rng(1);
-  std::uniform_int_distribution<int> pct(0, 99);
-  for (std::uint8_t& b : stream)
-    if (pct(rng) == 0) b = static_cast<std::uint8_t>(rng());
+  bench::corrupt(stream, 0.01, rng);
   return stream;
 }
 
-struct CountingSink : DecodedSink {
-  std::uint64_t samples = 0;
-  double sum = 0.0;
-  void on_sample(const DecodedSample& s) override {
-    ++samples;
-    sum += s.orientation.w();
-  }
-};
-
 void BM_XsensDecode(benchmark::State& state) {
   static const std::vector<std::uint8_t> stream = make_stream();
-  const auto chunk = static_cast<std::size_t>(state.range(0));
   auto decoder = make_xsens_decoder();
-  CountingSink sink;
-  for (auto _ : state) {
-    for (std::size_t pos = 0; pos < stream.size(); pos += chunk)
-      decoder->feed({stream.data() + pos, std::min(chunk, stream.size() - pos)}, sink);
-    benchmark::DoNotOptimize(sink.sum);
-  }
-  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * stream.size()));
-  const DecoderCounters& c = decoder->counters();
-  state.counters["samples_per_MB"] = static_cast<double>(c.samples) / (static_cast<double>(c.bytes) / 1e6);
-  state.counters["bad_checksum_pct"] = 100.0 * static_cast<double>(c.bad_checksum) / static_cast<double>(c.bad_checksum + c.frames);
+  bench::decode_in_reads(state, *decoder, stream, static_cast<std::size_t>(state.range(0)));
 }
 BENCHMARK(BM_XsensDecode)->Arg(64)->Arg(4096);
 

@@ -9,16 +9,12 @@
 #include <random>
 #include <vector>
 
+#include "decoder_bench.hpp"
 #include "posefair/core/so3.hpp"
 #include "posefair/drivers/yost_decoder.hpp"
 
 namespace posefair::drivers {
 namespace {
-
-struct Counter final : DecodedSink {
-  std::uint64_t n = 0;
-  void on_sample(const DecodedSample&) override { ++n; }
-};
 
 // 100000 packets at 1 kHz of a smooth random motion, then ~1% of the bytes replaced.
 std::vector<std::uint8_t> stream(bool random_only) {
@@ -38,25 +34,14 @@ std::vector<std::uint8_t> stream(bool random_only) {
     const std::vector<std::uint8_t> p = encode_yost_quaternion_packet(q, 0xFFF00000u + 1000u * k);
     bytes.insert(bytes.end(), p.begin(), p.end());
   }
-  std::bernoulli_distribution corrupt(0.01);
-  for (auto& b : bytes)
-    if (corrupt(rng)) b = static_cast<std::uint8_t>(rng());
+  bench::corrupt(bytes, 0.01, rng);
   return bytes;
 }
 
 void BM_Yost(benchmark::State& state, bool random_only) {
   const std::vector<std::uint8_t> data = stream(random_only);
-  const auto chunk = static_cast<std::size_t>(state.range(0));
   auto decoder = make_yost_decoder({});
-  Counter sink;
-  for (auto _ : state) {
-    for (std::size_t at = 0; at < data.size(); at += chunk)
-      decoder->feed({data.data() + at, std::min(chunk, data.size() - at)}, sink);
-    benchmark::DoNotOptimize(sink.n);
-  }
-  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(data.size()));
-  state.counters["samples_per_pass"] = static_cast<double>(sink.n) / static_cast<double>(state.iterations());
-  state.counters["stream_kB"] = static_cast<double>(data.size()) / 1000.0;
+  bench::decode_in_reads(state, *decoder, data, static_cast<std::size_t>(state.range(0)));
 }
 
 BENCHMARK_CAPTURE(BM_Yost, packets_1pct_corrupt, false)->Arg(64)->Arg(4096)->Unit(benchmark::kMillisecond);

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "../../support/decoder_testing.hpp"
 #include "posefair/core/so3.hpp"
 #include "posefair/drivers/bno08x_rvc_decoder.hpp"
 #include "posefair/drivers/checksums.hpp"
@@ -18,6 +19,7 @@
 namespace posefair::drivers {
 namespace {
 
+using namespace ::posefair::testing;
 using Bytes = std::vector<std::uint8_t>;
 constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr std::size_t kFrame = kBno08xRvcFrameSize;
@@ -29,16 +31,6 @@ constexpr std::size_t kFrame = kBno08xRvcFrameSize;
 const Bytes kDatasheetExample = {0xAA, 0xAA, 0xDE, 0x01, 0x00, 0x92, 0xFF, 0x25, 0x08, 0x8D,
                                  0xFE, 0xEC, 0xFF, 0xD1, 0x03, 0x00, 0x00, 0x00, 0xE7};
 
-struct Collect : DecodedSink {
-  std::vector<DecodedSample> samples;
-  void on_sample(const DecodedSample& s) override { samples.push_back(s); }
-};
-
-struct Decoded {
-  std::vector<DecodedSample> samples;
-  DecoderCounters counters;
-};
-
 template <std::size_t N>
 void append(Bytes& out, const std::array<std::uint8_t, N>& frame) {
   out.insert(out.end(), frame.begin(), frame.end());
@@ -46,43 +38,13 @@ void append(Bytes& out, const std::array<std::uint8_t, N>& frame) {
 
 std::unique_ptr<Decoder> make() { return make_bno08x_rvc_decoder(DecoderOptions{}); }
 
-Decoded decode_cut(const Bytes& stream, const std::vector<std::size_t>& cuts) {
-  auto d = make();
-  Collect sink;
-  std::size_t start = 0;
-  for (std::size_t c : cuts) {
-    d->feed(std::span<const std::uint8_t>(stream.data() + start, c - start), sink);
-    start = c;
-  }
-  d->feed(std::span<const std::uint8_t>(stream.data() + start, stream.size() - start), sink);
-  return {sink.samples, d->counters()};
-}
-
-Decoded decode(const Bytes& stream) { return decode_cut(stream, {}); }
-
-bool same(const DecodedSample& a, const DecodedSample& b) {
-  return a.orientation.coeffs() == b.orientation.coeffs() && a.position == b.position && a.flags == b.flags &&
-         a.device_time == b.device_time && a.frame_counter == b.frame_counter &&
-         a.has_frame_counter == b.has_frame_counter;
-}
-
-void expect_same(const Decoded& a, const Decoded& b, const std::string& what) {
-  EXPECT_EQ(a.counters, b.counters) << what;
-  ASSERT_EQ(a.samples.size(), b.samples.size()) << what;
-  for (std::size_t i = 0; i < a.samples.size(); ++i) EXPECT_TRUE(same(a.samples[i], b.samples[i])) << what << " sample " << i;
-}
+Decoded decode(const Bytes& stream) { return decode_chunks(make(), stream); }
 
 void expect_consistent(const DecoderCounters& c) {
   EXPECT_EQ(c.frames, c.samples + c.malformed);
   EXPECT_EQ(c.ignored_frames, 0u);
   EXPECT_LE(c.skipped_bytes + kFrame * c.frames, c.bytes);
   EXPECT_GT(c.skipped_bytes + kFrame * c.frames + kFrame, c.bytes);
-}
-
-// R = Rz(yaw) Ry(pitch) Rx(roll), built here without the library's Euler code.
-Quat zyx(double yaw_deg, double pitch_deg, double roll_deg) {
-  return Quat(Eigen::AngleAxisd(yaw_deg * kDeg, Vec3::UnitZ())) * Quat(Eigen::AngleAxisd(pitch_deg * kDeg, Vec3::UnitY())) *
-         Quat(Eigen::AngleAxisd(roll_deg * kDeg, Vec3::UnitX()));
 }
 
 // 100 Hz of smooth synthetic motion; with garbage: junk bytes now and then, broken checksums, and
@@ -201,7 +163,7 @@ TEST(Bno08xRvcDecoder, IndexRolloverIsUnwrapped) {
 
   // Across many wraps, and reset() starting over from the raw index.
   auto d = make();
-  Collect sink;
+  Collector sink;
   for (int i = 0; i < 1000; ++i) d->feed(encode_bno08x_rvc(static_cast<std::uint8_t>(i + 7), 0, 0, 0), sink);
   ASSERT_EQ(sink.samples.size(), 1000u);
   for (std::size_t i = 0; i < sink.samples.size(); ++i) ASSERT_EQ(sink.samples[i].frame_counter, i + 7);
@@ -217,16 +179,9 @@ TEST(Bno08xRvcDecoder, AnySplitGivesTheSameSamplesAndCounters) {
   ASSERT_GT(whole.samples.size(), 45u);
   ASSERT_GT(whole.counters.bad_checksum, 0u);
   ASSERT_GT(whole.counters.resyncs, 1u);
-  for (std::size_t cut = 0; cut <= stream.size(); ++cut) expect_same(whole, decode_cut(stream, {cut}), "cut " + std::to_string(cut));
-  std::vector<std::size_t> every(stream.size());
-  for (std::size_t i = 0; i < every.size(); ++i) every[i] = i;
-  expect_same(whole, decode_cut(stream, every), "byte by byte");
-  for (int trial = 0; trial < 300; ++trial) {
-    std::uniform_int_distribution<std::size_t> len(0, trial % 2 ? 20 : 60);
-    std::vector<std::size_t> cuts;
-    for (std::size_t c = len(rng); c < stream.size(); c += len(rng)) cuts.push_back(c);
-    expect_same(whole, decode_cut(stream, cuts), "trial " + std::to_string(trial));
-  }
+  expect_every_split_same(make, stream, whole);
+  expect_byte_by_byte_same(make, stream, whole);
+  expect_random_chunkings_same(make, stream, whole, rng, 300, {60, 20});  // empty chunks too
   expect_consistent(whole.counters);
 }
 
@@ -272,7 +227,7 @@ TEST(Bno08xRvcDecoder, ResynchronisationCountedExactly) {
   ASSERT_EQ(starts, (std::vector<std::size_t>{24, 25, 26, 27, 28, 36}));
 
   auto d = make();
-  Collect sink;
+  Collector sink;
   d->feed(s, sink);
   DecoderCounters want;
   want.bytes = s.size();
@@ -329,7 +284,7 @@ TEST(Bno08xRvcDecoder, OutOfRangeAnglesAreMalformed) {
 TEST(Bno08xRvcDecoder, ResetForgetsAPartialFrame) {
   const auto f = encode_bno08x_rvc(5, 10, 0, 0);
   auto d = make();
-  Collect sink;
+  Collector sink;
   d->feed(std::span<const std::uint8_t>(f.data(), 9), sink);
   d->reset();
   d->feed(std::span<const std::uint8_t>(f.data() + 9, 10), sink);
@@ -346,28 +301,15 @@ TEST(Bno08xRvcDecoder, ResetForgetsAPartialFrame) {
 TEST(Bno08xRvcDecoder, RandomBytes) {
   constexpr std::size_t kBytes = 10'000'000;
   std::mt19937_64 rng(20171001);
-  Bytes data(kBytes);
-  for (auto& b : data) b = static_cast<std::uint8_t>(rng());
-  auto d = make();
-  Collect sink;
-  std::uniform_int_distribution<std::size_t> len(1, 4096);
-  for (std::size_t at = 0; at < kBytes;) {
-    const std::size_t n = std::min(len(rng), kBytes - at);
-    d->feed(std::span<const std::uint8_t>(data.data() + at, n), sink);
-    at += n;
-  }
-  const DecoderCounters& c = d->counters();
+  const Bytes data = random_bytes(kBytes, rng);
+  const Decoded r = decode_in_random_reads(make(), data, rng);
+  const DecoderCounters& c = r.counters;
   EXPECT_EQ(c.bytes, kBytes);
   expect_consistent(c);
-  const double accept_mean = kBytes / 16777216.0;
-  EXPECT_LE(static_cast<double>(c.frames), accept_mean + 6.0 * std::sqrt(accept_mean)) << c.frames;
-  const double bad_mean = kBytes / 65536.0 * (255.0 / 256.0);
-  EXPECT_NEAR(static_cast<double>(c.bad_checksum), bad_mean, 6.0 * std::sqrt(bad_mean));
-  for (const auto& s : sink.samples) {
-    ASSERT_TRUE(s.orientation.coeffs().allFinite());
-    ASSERT_NEAR(s.orientation.norm(), 1.0, 1e-12);
-    ASSERT_TRUE(s.has_frame_counter);
-  }
+  expect_poisson_at_most(c.frames, kBytes / 16777216.0);
+  expect_poisson_near(c.bad_checksum, kBytes / 65536.0 * (255.0 / 256.0));
+  expect_unit_quaternions(r.samples);
+  for (const auto& s : r.samples) ASSERT_TRUE(s.has_frame_counter);
 
   // Random bytes with valid frames spliced in every ~500 bytes: every one of them is found.
   Bytes mixed(data.begin(), data.begin() + 1'000'000);

@@ -24,6 +24,7 @@
 #include <string_view>
 #include <vector>
 
+#include "../../support/decoder_testing.hpp"
 #include "../../support/test_files.hpp"
 #include "posefair/core/so3.hpp"
 #include "posefair/drivers/vectornav_decoder.hpp"
@@ -31,56 +32,23 @@
 namespace posefair::drivers {
 namespace {
 
+using namespace ::posefair::testing;
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-struct Recorder final : DecodedSink {
-  std::vector<DecodedSample> samples;
-  void on_sample(const DecodedSample& s) override { samples.push_back(s); }
-};
-
-struct Outcome {
-  std::vector<DecodedSample> samples;
-  DecoderCounters counters;
-};
 
 std::span<const std::uint8_t> bytes_of(std::string_view s) {
   return {reinterpret_cast<const std::uint8_t*>(s.data()), s.size()};
 }
 
 // Feeds `stream` cut at the given chunk sizes (the rest as one last chunk).
-Outcome decode(std::string_view stream, const std::vector<std::size_t>& chunks = {}, const DecoderOptions& options = {}) {
-  auto d = make_vectornav_decoder(options);
-  Recorder r;
-  std::size_t at = 0;
-  for (const std::size_t c : chunks) {
-    const std::size_t n = std::min(c, stream.size() - at);
-    d->feed(bytes_of(stream.substr(at, n)), r);
-    at += n;
-  }
-  d->feed(bytes_of(stream.substr(at)), r);
-  return {r.samples, d->counters()};
+Decoded decode(std::string_view stream, const std::vector<std::size_t>& chunks = {}, const DecoderOptions& options = {}) {
+  return decode_chunks(make_vectornav_decoder(options), bytes_of(stream), chunks);
 }
 
-Outcome decode_with(std::string_view stream, const DecoderOptions& options) { return decode(stream, {}, options); }
-
-void expect_same(const Outcome& a, const Outcome& b, const std::string& what) {
-  EXPECT_EQ(a.counters, b.counters) << what;
-  ASSERT_EQ(a.samples.size(), b.samples.size()) << what;
-  for (std::size_t k = 0; k < a.samples.size(); ++k) {
-    EXPECT_EQ(a.samples[k].orientation.coeffs(), b.samples[k].orientation.coeffs()) << what << " sample " << k;
-    EXPECT_EQ(a.samples[k].flags, b.samples[k].flags) << what << " sample " << k;
-  }
-}
-
-// Rz(yaw) · Ry(pitch) · Rx(roll), built here from Eigen alone (not the decoder's Euler code).
-Quat zyx(double yaw_deg, double pitch_deg, double roll_deg) {
-  return Quat(Eigen::AngleAxisd(yaw_deg * kDeg, Vec3::UnitZ())) * Quat(Eigen::AngleAxisd(pitch_deg * kDeg, Vec3::UnitY())) *
-         Quat(Eigen::AngleAxisd(roll_deg * kDeg, Vec3::UnitX()));
-}
+Decoded decode_with(std::string_view stream, const DecoderOptions& options) { return decode(stream, {}, options); }
 
 double angle(const Quat& a, const Quat& b) { return so3::rotation_angle(a, b); }
 
-Quat only_sample(const Outcome& r) {
+Quat only_sample(const Decoded& r) {
   EXPECT_EQ(r.samples.size(), 1u);
   return r.samples.empty() ? Quat(0, 0, 0, 0) : r.samples.front().orientation;
 }
@@ -109,7 +77,7 @@ TEST(VectorNavDecoder, ProtocolName) { EXPECT_EQ(make_vectornav_decoder({})->pro
 TEST(VectorNavDecoder, VendorRegisterResponsesAndErrorsAreValidFramesWithoutSamples) {
   const std::string stream = kReg8 + kReg9 + kReg15 + kReg27 + "$VNRRG,30,2,0,0,0,1,0,1*6E\r\n" + "$VNERR,03*72\r\n" +
                              "$VNRRG,11*73\r\n";
-  const Outcome r = decode(stream);
+  const Decoded r = decode(stream);
   EXPECT_EQ(r.counters.frames, 7u);  // every printed checksum verifies
   EXPECT_EQ(r.counters.ignored_frames, 7u);
   EXPECT_EQ(r.counters.bad_checksum, 0u);
@@ -121,7 +89,7 @@ TEST(VectorNavDecoder, VendorAsyncYprSentenceDecodesToItsAngles) {
   // UM004 §5.11.1, byte for byte; then with the SerialCount field the device appends.
   const Quat expected = zyx(10.071, 0.278, -2.026);
   for (const std::string s : {"$VNYPR,+010.071,+000.278,-002.026*60\r\n", "$VNYPR,+010.071,+000.278,-002.026,T1162704*2F\r\n"}) {
-    const Outcome r = decode(s);
+    const Decoded r = decode(s);
     EXPECT_EQ(r.counters.frames, 1u) << s;
     EXPECT_LT(angle(only_sample(r), expected), 1e-12) << s;
   }
@@ -154,7 +122,7 @@ TEST(VectorNavConventions, ManualExamplePairsAgreeOnlyWithoutConjugate) {
   EXPECT_GT(angle(ymr27, qmr15.conjugate()), 10.0 * kDeg);
 }
 
-Vec3 turn(const Outcome& r, const Vec3& v) { return only_sample(r) * v; }
+Vec3 turn(const Decoded& r, const Vec3& v) { return only_sample(r) * v; }
 
 TEST(VectorNavConventions, YawPitchRollAreIntrinsicZyxFromBodyToNed) {
   const auto ymr = [](double y, double p, double r) { return decode(encode_vectornav_vnymr(y, p, r, false)); };
@@ -173,7 +141,7 @@ TEST(VectorNavConventions, YawPitchRollAreIntrinsicZyxFromBodyToNed) {
 TEST(VectorNavConventions, QuaternionScalarIsLastOnTheWire) {
   // 90° about z, written x y z w: turns x onto y.
   const std::string body = "VNQTN,+0.000000,+0.000000,+0.707107,+0.707107";
-  const Outcome r = decode("$" + body + "*" + vectornav_checksum(body, false) + "\r\n");
+  const Decoded r = decode("$" + body + "*" + vectornav_checksum(body, false) + "\r\n");
   EXPECT_LT((turn(r, Vec3::UnitX()) - Vec3::UnitY()).norm(), 1e-6);
 }
 
@@ -195,7 +163,7 @@ TEST(VectorNavRoundTrip, RandomQuaternionsBothChecksums) {
       truth.push_back(q);
       stream += encode_vectornav_vnqmr(q, crc);
     }
-    const Outcome r = decode(stream);
+    const Decoded r = decode(stream);
     ASSERT_EQ(r.samples.size(), truth.size());
     EXPECT_EQ(r.counters.frames, truth.size());
     EXPECT_EQ(r.counters.malformed + r.counters.bad_checksum + r.counters.skipped_bytes, 0u);
@@ -217,7 +185,7 @@ TEST(VectorNavRoundTrip, RandomYawPitchRollBothChecksums) {
       truth.push_back(zyx(y, p, r));
       stream += encode_vectornav_vnymr(y, p, r, crc);
     }
-    const Outcome r = decode(stream);
+    const Decoded r = decode(stream);
     ASSERT_EQ(r.samples.size(), truth.size());
     for (std::size_t k = 0; k < truth.size(); ++k)
       EXPECT_LT(angle(r.samples[k].orientation, truth[k]), 3 * 0.0005 * kDeg) << k;  // 3 decimals of degrees
@@ -245,26 +213,20 @@ std::string mixed_stream() {
 
 TEST(VectorNavStream, AnySplitGivesIdenticalSamplesAndCounters) {
   const std::string stream = mixed_stream();
-  const Outcome whole = decode(stream);
+  const Decoded whole = decode(stream);
   EXPECT_EQ(whole.samples.size(), 11u);
   EXPECT_EQ(whole.counters.bad_checksum, 3u);  // flipped digit, "XX", "$VNQTN,+0.5*00"
   EXPECT_EQ(whole.counters.bytes, stream.size());
-  for (std::size_t cut = 0; cut <= stream.size(); ++cut) expect_same(whole, decode(stream, {cut}), "cut " + std::to_string(cut));
-  expect_same(whole, decode(stream, std::vector<std::size_t>(stream.size(), 1)), "byte by byte");
+  const auto make = [] { return make_vectornav_decoder({}); };
+  expect_every_split_same(make, bytes_of(stream), whole);
+  expect_byte_by_byte_same(make, bytes_of(stream), whole);
   std::mt19937_64 rng(5);
-  for (int trial = 0; trial < 200; ++trial) {
-    std::vector<std::size_t> chunks;
-    for (std::size_t at = 0; at < stream.size();) {
-      chunks.push_back(std::uniform_int_distribution<std::size_t>(0, 40)(rng));
-      at += chunks.back();
-    }
-    expect_same(whole, decode(stream, chunks), "trial " + std::to_string(trial));
-  }
+  expect_random_chunkings_same(make, bytes_of(stream), whole, rng, 200, {40});
 }
 
 TEST(VectorNavResync, GarbageBeforeAndBetweenSentences) {
   const std::string garbage("\x00\x13\xfe\r\n*,VN12", 11);
-  const Outcome r = decode(garbage + kYpr8 + garbage + kYpr8);
+  const Decoded r = decode(garbage + kYpr8 + garbage + kYpr8);
   EXPECT_EQ(r.samples.size(), 2u);
   EXPECT_EQ(r.counters.resyncs, 2u);
   EXPECT_EQ(r.counters.skipped_bytes, 2 * garbage.size());
@@ -273,7 +235,7 @@ TEST(VectorNavResync, GarbageBeforeAndBetweenSentences) {
 
 TEST(VectorNavResync, TruncatedSentenceIsDroppedAtTheNextDollar) {
   const std::string half = kQmr15.substr(0, 60);
-  const Outcome r = decode(half + kQmr15);
+  const Decoded r = decode(half + kQmr15);
   EXPECT_EQ(r.samples.size(), 1u);
   EXPECT_EQ(r.counters.frames, 1u);
   EXPECT_EQ(r.counters.resyncs, 1u);
@@ -283,7 +245,7 @@ TEST(VectorNavResync, TruncatedSentenceIsDroppedAtTheNextDollar) {
 TEST(VectorNavResync, NonTextByteEndsASentence) {
   std::string broken = kYmr27;
   broken[30] = '\x07';
-  const Outcome r = decode(broken + kYmr27);
+  const Decoded r = decode(broken + kYmr27);
   EXPECT_EQ(r.samples.size(), 1u);
   EXPECT_EQ(r.counters.bad_checksum, 0u);
   EXPECT_EQ(r.counters.skipped_bytes, broken.size());  // from '$' through '\n'
@@ -299,7 +261,7 @@ TEST(VectorNavResync, BadChecksumIsCountedAndTheNextSentenceDecodes) {
     flipped_checksum[star + 1] = flipped_checksum[star + 1] == 'A' ? 'B' : 'A';
     std::string no_star = good;
     no_star[star] = '#';
-    const Outcome r = decode(flipped_digit + good + flipped_checksum + good + no_star + good);
+    const Decoded r = decode(flipped_digit + good + flipped_checksum + good + no_star + good);
     EXPECT_EQ(r.counters.bad_checksum, 3u) << crc;
     EXPECT_EQ(r.counters.frames, 3u) << crc;
     EXPECT_EQ(r.samples.size(), 3u) << crc;
@@ -317,7 +279,7 @@ TEST(VectorNavResync, EverySingleCharacterCorruptionIsRejected) {
         if (c == good[at]) continue;
         std::string s = good;
         s[at] = c;
-        const Outcome r = decode(s);
+        const Decoded r = decode(s);
         EXPECT_EQ(r.samples.size(), 0u) << crc << " " << s;
       }
     }
@@ -326,7 +288,7 @@ TEST(VectorNavResync, EverySingleCharacterCorruptionIsRejected) {
 
 TEST(VectorNavResync, OverlongSentenceIsDiscardedNotBuffered) {
   const std::string junk = "$" + std::string(10000, 'A');  // no '\n' at all
-  const Outcome r = decode(junk + kYpr8);
+  const Decoded r = decode(junk + kYpr8);
   EXPECT_EQ(r.samples.size(), 1u);
   EXPECT_EQ(r.counters.resyncs, 1u);
   EXPECT_EQ(r.counters.skipped_bytes, junk.size());
@@ -338,10 +300,10 @@ TEST(VectorNavResync, OverlongSentenceIsDiscardedNotBuffered) {
     return "$" + body + "*" + vectornav_checksum(body, false) + "\r\n";
   };
   ASSERT_EQ(line(kVectorNavMaxSentence).size(), kVectorNavMaxSentence);
-  const Outcome at_bound = decode(line(kVectorNavMaxSentence));
+  const Decoded at_bound = decode(line(kVectorNavMaxSentence));
   EXPECT_EQ(at_bound.counters.frames, 1u);
   EXPECT_EQ(at_bound.counters.ignored_frames, 1u);
-  const Outcome over = decode(line(kVectorNavMaxSentence + 1) + kYpr8);
+  const Decoded over = decode(line(kVectorNavMaxSentence + 1) + kYpr8);
   EXPECT_EQ(over.counters.frames, 1u);  // only the YPR
   EXPECT_EQ(over.samples.size(), 1u);
   EXPECT_EQ(over.counters.skipped_bytes, kVectorNavMaxSentence + 1);
@@ -350,20 +312,20 @@ TEST(VectorNavResync, OverlongSentenceIsDiscardedNotBuffered) {
 TEST(VectorNavChecksumOff, XXIsRejectedByDefaultAndAcceptedOnRequest) {
   const std::string unchecked = "$VNYPR,+010.071,+000.278,-002.026*XX\r\n";
   const std::string unchecked4 = "$VNYPR,+010.071,+000.278,-002.026*XXXX\r\n";
-  const Outcome def = decode(unchecked + unchecked4);
+  const Decoded def = decode(unchecked + unchecked4);
   EXPECT_EQ(def.counters.bad_checksum, 2u);
   EXPECT_EQ(def.counters.frames, 0u);
   EXPECT_TRUE(def.samples.empty());
 
   DecoderOptions accept;
   accept.vectornav_unchecked = "accept";
-  const Outcome acc = decode_with(unchecked + unchecked4, accept);
+  const Decoded acc = decode_with(unchecked + unchecked4, accept);
   EXPECT_EQ(acc.counters.frames, 2u);
   ASSERT_EQ(acc.samples.size(), 2u);
   EXPECT_LT(angle(acc.samples[0].orientation, zyx(10.071, 0.278, -2.026)), 1e-12);
 
   // Unchecked sentences must also look exactly like the device's output.
-  const Outcome odd = decode_with("$VNYPR,10.071,+000.278,-002.026*XX\r\n$VNYPR,+010.071,+000.278,-002.026,X1*XX\r\n", accept);
+  const Decoded odd = decode_with("$VNYPR,10.071,+000.278,-002.026*XX\r\n$VNYPR,+010.071,+000.278,-002.026,X1*XX\r\n", accept);
   EXPECT_EQ(odd.counters.malformed, 2u);
   EXPECT_TRUE(odd.samples.empty());
   // ... while a checked sentence need not (its checksum already vouches for it).
@@ -396,7 +358,7 @@ TEST(VectorNavMalformed, ValidChecksumButImpossibleContents) {
   };
   std::string stream;
   for (const std::string& b : bodies) stream += with_checksum(b);
-  const Outcome r = decode(stream);
+  const Decoded r = decode(stream);
   EXPECT_EQ(r.counters.frames, bodies.size());
   EXPECT_EQ(r.counters.malformed, bodies.size());
   EXPECT_TRUE(r.samples.empty());
@@ -406,7 +368,7 @@ TEST(VectorNavMalformed, ValidChecksumButImpossibleContents) {
 
 TEST(VectorNavDecoder, ResetForgetsAPartialSentence) {
   auto d = make_vectornav_decoder({});
-  Recorder r;
+  Collector r;
   d->feed(bytes_of(kYpr8.substr(0, 20)), r);
   d->reset();
   d->feed(bytes_of(kYpr8.substr(20)), r);
@@ -430,12 +392,9 @@ TEST(VectorNavRandom, RandomChecksumFieldsAreAcceptedAtTheChecksumsRate) {
       for (std::size_t i = star + 1; i < s.size() - 2; ++i) s[i] = hex[rng() % 16];
       stream += s;
     }
-    const Outcome r = decode(stream);
-    const double p = crc ? 1.0 / 65536 : 1.0 / 256;
-    const double mean = kN * p;
-    const double sd = std::sqrt(kN * p * (1 - p));
-    EXPECT_LE(static_cast<double>(r.counters.frames), mean + 6 * sd + 3) << crc;
-    EXPECT_GE(static_cast<double>(r.counters.frames), mean - 6 * sd - 3) << crc;
+    const Decoded r = decode(stream);
+    SCOPED_TRACE(crc ? "CRC-16" : "XOR");
+    expect_binomial_within(r.counters.frames, kN, crc ? 1.0 / 65536 : 1.0 / 256, 3);
     EXPECT_EQ(r.counters.frames + r.counters.bad_checksum, static_cast<std::uint64_t>(kN));
   }
 }
@@ -447,42 +406,32 @@ TEST(VectorNavRandom, RandomChecksumFieldsAreAcceptedAtTheChecksumsRate) {
 // ≈ 1e-4. The bound allows 2.
 TEST(VectorNavRandom, TenMegabytesOfRandomBytes) {
   std::mt19937_64 rng(1);
-  std::vector<std::uint8_t> data(10'000'000);
-  for (auto& b : data) b = static_cast<std::uint8_t>(rng());
-  auto d = make_vectornav_decoder({});
-  Recorder r;
-  for (std::size_t at = 0; at < data.size();) {
-    const std::size_t n = std::min<std::size_t>(std::uniform_int_distribution<std::size_t>(1, 4096)(rng), data.size() - at);
-    d->feed({data.data() + at, n}, r);
-    at += n;
-  }
-  EXPECT_EQ(d->counters().bytes, data.size());
-  EXPECT_LE(d->counters().frames, 2u);
-  for (const DecodedSample& s : r.samples) {
-    EXPECT_TRUE(s.orientation.coeffs().allFinite());
-    EXPECT_NEAR(s.orientation.norm(), 1.0, 1e-12);
-  }
+  const std::vector<std::uint8_t> data = random_bytes(10'000'000, rng);
+  const Decoded r = decode_in_random_reads(make_vectornav_decoder({}), data, rng);
+  EXPECT_EQ(r.counters.bytes, data.size());
+  EXPECT_LE(r.counters.frames, 2u);
+  expect_unit_quaternions(r.samples);
 }
 
 // The fuzz seed corpus (tests/fuzz/corpus/vectornav/) is written by a separate generator
 // (Python, not these encoders): it must decode as intended, CRC-16 sentences included.
 TEST(VectorNavCorpus, SeedFilesDecodeAsIntended) {
   const std::string dir = std::string(POSEFAIR_SOURCE_DIR) + "/tests/fuzz/corpus/vectornav/";
-  const Outcome vendor = decode(::posefair::testing::slurp(dir + "vendor_examples.txt"));
+  const Decoded vendor = decode(::posefair::testing::slurp(dir + "vendor_examples.txt"));
   EXPECT_EQ(vendor.counters.frames, 8u);
   EXPECT_EQ(vendor.samples.size(), 2u);  // the two $VNYPR lines
   for (const char* name : {"vnqmr_xor.txt", "vnymr_crc16.txt"}) {
-    const Outcome r = decode(::posefair::testing::slurp(dir + name));
+    const Decoded r = decode(::posefair::testing::slurp(dir + name));
     EXPECT_EQ(r.samples.size(), 12u) << name;
     EXPECT_EQ(r.counters.bad_checksum + r.counters.malformed + r.counters.skipped_bytes, 0u) << name;
   }
   // Same smooth motion, written once as quaternions and once as angles.
-  const Outcome q = decode(::posefair::testing::slurp(dir + "vnqmr_xor.txt"));
-  const Outcome e = decode(::posefair::testing::slurp(dir + "vnymr_crc16.txt"));
+  const Decoded q = decode(::posefair::testing::slurp(dir + "vnqmr_xor.txt"));
+  const Decoded e = decode(::posefair::testing::slurp(dir + "vnymr_crc16.txt"));
   ASSERT_EQ(q.samples.size(), e.samples.size());
   for (std::size_t k = 0; k < q.samples.size(); ++k)
     EXPECT_LT(angle(q.samples[k].orientation, e.samples[k].orientation), 1e-4) << k;
-  const Outcome mixed = decode(::posefair::testing::slurp(dir + "mixed_garbage.bin"));
+  const Decoded mixed = decode(::posefair::testing::slurp(dir + "mixed_garbage.bin"));
   EXPECT_EQ(mixed.samples.size(), 4u);
   EXPECT_EQ(mixed.counters.bad_checksum, 2u);
 }

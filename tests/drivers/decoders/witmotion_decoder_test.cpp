@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "../../support/decoder_testing.hpp"
 #include "posefair/core/so3.hpp"
 #include "posefair/drivers/checksums.hpp"
 #include "posefair/drivers/witmotion_decoder.hpp"
@@ -26,18 +27,9 @@
 namespace posefair::drivers {
 namespace {
 
+using namespace ::posefair::testing;
 using Bytes = std::vector<std::uint8_t>;
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-struct Collect : DecodedSink {
-  std::vector<DecodedSample> samples;
-  void on_sample(const DecodedSample& s) override { samples.push_back(s); }
-};
-
-struct Decoded {
-  std::vector<DecodedSample> samples;
-  DecoderCounters counters;
-};
 
 template <std::size_t N>
 void append(Bytes& out, const std::array<std::uint8_t, N>& frame) {
@@ -50,32 +42,7 @@ std::unique_ptr<Decoder> make(const std::string& scalar = "first") {
   return make_witmotion_decoder(o);
 }
 
-// Feeds `stream` cut at the given increasing offsets.
-Decoded decode_cut(const Bytes& stream, const std::vector<std::size_t>& cuts, const std::string& scalar = "first") {
-  auto d = make(scalar);
-  Collect sink;
-  std::size_t start = 0;
-  for (std::size_t c : cuts) {
-    d->feed(std::span<const std::uint8_t>(stream.data() + start, c - start), sink);
-    start = c;
-  }
-  d->feed(std::span<const std::uint8_t>(stream.data() + start, stream.size() - start), sink);
-  return {sink.samples, d->counters()};
-}
-
-Decoded decode(const Bytes& stream, const std::string& scalar = "first") { return decode_cut(stream, {}, scalar); }
-
-bool same(const DecodedSample& a, const DecodedSample& b) {
-  return a.orientation.coeffs() == b.orientation.coeffs() && a.position == b.position && a.flags == b.flags &&
-         a.device_time == b.device_time && a.frame_counter == b.frame_counter &&
-         a.has_frame_counter == b.has_frame_counter;
-}
-
-void expect_same(const Decoded& a, const Decoded& b, const std::string& what) {
-  EXPECT_EQ(a.counters, b.counters) << what;
-  ASSERT_EQ(a.samples.size(), b.samples.size()) << what;
-  for (std::size_t i = 0; i < a.samples.size(); ++i) EXPECT_TRUE(same(a.samples[i], b.samples[i])) << what << " sample " << i;
-}
+Decoded decode(const Bytes& stream, const std::string& scalar = "first") { return decode_chunks(make(scalar), stream); }
 
 // Every valid frame is a sample, ignored or malformed; every byte fed is skipped, in a frame, or
 // still held (fewer than a frame).
@@ -83,18 +50,6 @@ void expect_consistent(const DecoderCounters& c) {
   EXPECT_EQ(c.frames, c.samples + c.ignored_frames + c.malformed);
   EXPECT_LE(c.skipped_bytes + kWitMotionFrameSize * c.frames, c.bytes);
   EXPECT_GT(c.skipped_bytes + kWitMotionFrameSize * c.frames + kWitMotionFrameSize, c.bytes);
-}
-
-// R = Rz(yaw) Ry(pitch) Rx(roll), built here without the library's Euler code.
-Quat zyx(double yaw_deg, double pitch_deg, double roll_deg) {
-  return Quat(Eigen::AngleAxisd(yaw_deg * kDeg, Vec3::UnitZ())) * Quat(Eigen::AngleAxisd(pitch_deg * kDeg, Vec3::UnitY())) *
-         Quat(Eigen::AngleAxisd(roll_deg * kDeg, Vec3::UnitX()));
-}
-
-Quat random_unit(std::mt19937_64& rng) {
-  std::normal_distribution<double> n;
-  Quat q(n(rng), n(rng), n(rng), n(rng));
-  return q.normalized();
 }
 
 std::array<std::uint8_t, 11> accel_frame(std::uint8_t a = 0x12) {
@@ -198,7 +153,7 @@ TEST(WitMotionDecoder, QuaternionRoundTripWithinQuantisation) {
   double worst = 0.0;
   for (const bool first : {true, false}) {
     for (int i = 0; i < 20000; ++i) {
-      const Quat q = random_unit(rng);
+      const Quat q = random_unit_quaternion(rng);
       const auto f = encode_witmotion_quaternion(q, first);
       const Decoded r = decode(Bytes(f.begin(), f.end()), first ? "first" : "last");
       ASSERT_EQ(r.samples.size(), 1u);
@@ -322,7 +277,7 @@ TEST(WitMotionDecoder, DeviceTimeAndDayRollover) {
 
   // reset() forgets the day count; without time frames there is no device time.
   auto d = make();
-  Collect sink;
+  Collector sink;
   d->feed(std::span<const std::uint8_t>(s.data(), 22), sink);  // time 23:59:59.9, accel
   d->reset();
   Bytes t;
@@ -342,16 +297,10 @@ TEST(WitMotionDecoder, AnySplitGivesTheSameSamplesAndCounters) {
   ASSERT_GT(whole.samples.size(), 30u);
   ASSERT_GT(whole.counters.bad_checksum, 0u);
   ASSERT_GT(whole.counters.resyncs, 0u);
-  for (std::size_t cut = 0; cut <= stream.size(); ++cut) expect_same(whole, decode_cut(stream, {cut}), "cut " + std::to_string(cut));
-  std::vector<std::size_t> every(stream.size());
-  for (std::size_t i = 0; i < every.size(); ++i) every[i] = i;
-  expect_same(whole, decode_cut(stream, every), "byte by byte");
-  for (int trial = 0; trial < 300; ++trial) {
-    std::uniform_int_distribution<std::size_t> len(0, trial % 2 ? 12 : 40);
-    std::vector<std::size_t> cuts;
-    for (std::size_t c = len(rng); c < stream.size(); c += len(rng)) cuts.push_back(c);  // empty chunks too
-    expect_same(whole, decode_cut(stream, cuts), "trial " + std::to_string(trial));
-  }
+  const auto fresh = [] { return make(); };
+  expect_every_split_same(fresh, stream, whole);
+  expect_byte_by_byte_same(fresh, stream, whole);
+  expect_random_chunkings_same(fresh, stream, whole, rng, 300, {40, 12});  // empty chunks too
   expect_consistent(whole.counters);
 }
 
@@ -400,7 +349,7 @@ TEST(WitMotionDecoder, ResynchronisationCountedExactly) {
   }
 
   auto d = make();
-  Collect sink;
+  Collector sink;
   d->feed(s, sink);
   DecoderCounters want;
   want.bytes = s.size();
@@ -457,7 +406,7 @@ TEST(WitMotionDecoder, MalformedFrames) {
 TEST(WitMotionDecoder, ResetForgetsAPartialFrame) {
   const auto q = encode_witmotion_quaternion(zyx(10, 0, 0));
   auto d = make();
-  Collect sink;
+  Collector sink;
   d->feed(std::span<const std::uint8_t>(q.data(), 6), sink);
   d->reset();
   d->feed(std::span<const std::uint8_t>(q.data() + 6, 5), sink);
@@ -475,28 +424,15 @@ TEST(WitMotionDecoder, ResetForgetsAPartialFrame) {
 TEST(WitMotionDecoder, RandomBytes) {
   constexpr std::size_t kBytes = 10'000'000;
   std::mt19937_64 rng(20240229);
-  Bytes data(kBytes);
-  for (auto& b : data) b = static_cast<std::uint8_t>(rng());
+  const Bytes data = random_bytes(kBytes, rng);
   for (const char* scalar : {"first", "last"}) {
-    auto d = make(scalar);
-    Collect sink;
-    std::uniform_int_distribution<std::size_t> len(1, 4096);
-    for (std::size_t at = 0; at < kBytes;) {
-      const std::size_t n = std::min(len(rng), kBytes - at);
-      d->feed(std::span<const std::uint8_t>(data.data() + at, n), sink);
-      at += n;
-    }
-    const DecoderCounters& c = d->counters();
+    const Decoded r = decode_in_random_reads(make(scalar), data, rng);
+    const DecoderCounters& c = r.counters;
     EXPECT_EQ(c.bytes, kBytes);
     expect_consistent(c);
-    const double accept_mean = kBytes / 1048576.0;
-    EXPECT_LE(static_cast<double>(c.frames), accept_mean + 6.0 * std::sqrt(accept_mean)) << c.frames;
-    const double bad_mean = kBytes * (1.0 / 256) * (16.0 / 256) * (255.0 / 256);
-    EXPECT_NEAR(static_cast<double>(c.bad_checksum), bad_mean, 6.0 * std::sqrt(bad_mean));
-    for (const auto& s : sink.samples) {
-      ASSERT_TRUE(s.orientation.coeffs().allFinite());
-      ASSERT_NEAR(s.orientation.norm(), 1.0, 1e-12);
-    }
+    expect_poisson_at_most(c.frames, kBytes / 1048576.0);
+    expect_poisson_near(c.bad_checksum, kBytes * (1.0 / 256) * (16.0 / 256) * (255.0 / 256));
+    expect_unit_quaternions(r.samples);
   }
 }
 

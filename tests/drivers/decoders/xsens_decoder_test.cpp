@@ -25,38 +25,15 @@
 #include <string_view>
 #include <vector>
 
+#include "../../support/decoder_testing.hpp"
 #include "posefair/drivers/checksums.hpp"
 #include "posefair/drivers/xsens_decoder.hpp"
 
 namespace posefair::drivers {
 namespace {
 
+using namespace ::posefair::testing;
 using Bytes = std::vector<std::uint8_t>;
-
-Bytes hex(std::string_view text) {
-  Bytes out;
-  int hi = -1;
-  for (char c : text) {
-    int v = -1;
-    if (c >= '0' && c <= '9') v = c - '0';
-    if (c >= 'A' && c <= 'F') v = c - 'A' + 10;
-    if (c >= 'a' && c <= 'f') v = c - 'a' + 10;
-    if (v < 0) continue;
-    if (hi < 0) {
-      hi = v;
-    } else {
-      out.push_back(static_cast<std::uint8_t>(hi << 4 | v));
-      hi = -1;
-    }
-  }
-  return out;
-}
-
-Bytes cat(std::initializer_list<Bytes> parts) {
-  Bytes out;
-  for (const Bytes& p : parts) out.insert(out.end(), p.begin(), p.end());
-  return out;
-}
 
 // An Xbus message around `data`, built from the documented layout.
 Bytes message(std::uint8_t mid, const Bytes& data, bool extended = false) {
@@ -91,50 +68,9 @@ Bytes be_float(float v) {
 
 bool sums_to_zero(const Bytes& m) { return checksum::sum8({m.data() + 1, m.size() - 1}) == 0; }
 
-struct Collector : DecodedSink {
-  std::vector<DecodedSample> samples;
-  void on_sample(const DecodedSample& s) override { samples.push_back(s); }
-};
+std::unique_ptr<Decoder> make() { return make_xsens_decoder(); }
 
-struct Result {
-  std::vector<DecodedSample> samples;
-  DecoderCounters counters;
-};
-
-// Feeds `bytes` in chunks whose lengths `next_chunk` picks.
-template <typename NextChunk>
-Result decode_chunked(const Bytes& bytes, NextChunk next_chunk) {
-  auto d = make_xsens_decoder();
-  Collector c;
-  std::size_t pos = 0;
-  while (pos < bytes.size()) {
-    const std::size_t n = std::min(bytes.size() - pos, std::max<std::size_t>(1, next_chunk()));
-    d->feed({bytes.data() + pos, n}, c);
-    pos += n;
-  }
-  return {c.samples, d->counters()};
-}
-
-Result decode(const Bytes& bytes) {
-  return decode_chunked(bytes, [&] { return bytes.size(); });
-}
-
-bool same(const DecodedSample& a, const DecodedSample& b) {
-  return a.orientation.coeffs() == b.orientation.coeffs() && a.position == b.position && a.flags == b.flags &&
-         a.device_time == b.device_time && a.frame_counter == b.frame_counter &&
-         a.has_frame_counter == b.has_frame_counter;
-}
-
-void expect_same(const Result& a, const Result& b) {
-  EXPECT_EQ(a.counters, b.counters);
-  ASSERT_EQ(a.samples.size(), b.samples.size());
-  for (std::size_t k = 0; k < a.samples.size(); ++k) EXPECT_TRUE(same(a.samples[k], b.samples[k])) << "sample " << k;
-}
-
-Quat random_unit(std::mt19937_64& rng) {
-  std::normal_distribution<double> n;
-  return Quat(n(rng), n(rng), n(rng), n(rng)).normalized();
-}
+Decoded decode(const Bytes& bytes) { return decode_chunks(make(), bytes); }
 
 // ---- vendor examples ----
 
@@ -189,7 +125,7 @@ TEST(XsensDecoder, DocumentedSessionIsValidFramesWithoutOrientation) {
   Bytes stream;
   for (const char* m : kMtiDocsSession) stream = cat({stream, hex(m)});
   stream = cat({stream, hex(kMtiDocsMtData2)});
-  const Result r = decode(stream);
+  const Decoded r = decode(stream);
   EXPECT_EQ(r.counters.frames, 10u);
   EXPECT_EQ(r.counters.ignored_frames, 10u);
   EXPECT_EQ(r.counters.samples, 0u);
@@ -213,7 +149,7 @@ TEST(XsensDecoder, DocumentedMtData2CounterAndTimeAreRead) {
     // read them sees a rollover.
     const auto counter = static_cast<std::uint16_t>(c.counter - 1);
     const auto time = static_cast<std::uint32_t>(c.time - 1);
-    const Result r = decode(cat({hex(c.message), encode_xsens_mtdata2(Quat::Identity(), counter, time)}));
+    const Decoded r = decode(cat({hex(c.message), encode_xsens_mtdata2(Quat::Identity(), counter, time)}));
     ASSERT_EQ(r.samples.size(), 1u);
     EXPECT_EQ(r.counters.ignored_frames, 1u);
     EXPECT_EQ(r.samples[0].frame_counter, c.counter - 1 + 65536);
@@ -225,23 +161,28 @@ TEST(XsensDecoder, WakeUpAndErrorMessagesAreIgnored) {
   const Bytes wake_up = hex("FA FF 3E 00 C3");        // WakeUp, no data (built from the layout)
   const Bytes error = message(0x42, {0x04});            // Error, one error code byte
   ASSERT_TRUE(sums_to_zero(wake_up));
-  const Result r = decode(cat({wake_up, error, encode_xsens_mtdata2(Quat::Identity(), 1, std::nullopt)}));
+  const Decoded r = decode(cat({wake_up, error, encode_xsens_mtdata2(Quat::Identity(), 1, std::nullopt)}));
   EXPECT_EQ(r.counters.frames, 3u);
   EXPECT_EQ(r.counters.ignored_frames, 2u);
   EXPECT_EQ(r.samples.size(), 1u);
+}
+
+// q's components w, x, y, z each within 2e-7 of the ones given.
+void expect_wxyz_near(const Quat& q, double w, double x, double y, double z) {
+  EXPECT_NEAR(q.w(), w, 2e-7);
+  EXPECT_NEAR(q.x(), x, 2e-7);
+  EXPECT_NEAR(q.y(), y, 2e-7);
+  EXPECT_NEAR(q.z(), z, 2e-7);
 }
 
 // MT Manager decoded these recordings as printed (8 decimals); the float32 values are unit to
 // about 1e-7, and the decoder normalises.
 TEST(XsensDecoder, RecordedMti300MessagesDecodeAsMtManagerDecodedThem) {
   {
-    const Result r = decode(message(0x36, hex(kMti300Example6Data)));
+    const Decoded r = decode(message(0x36, hex(kMti300Example6Data)));
     ASSERT_EQ(r.samples.size(), 1u);
     const DecodedSample& s = r.samples[0];
-    EXPECT_NEAR(s.orientation.w(), 0.94455600, 2e-7);
-    EXPECT_NEAR(s.orientation.x(), -0.32308814, 2e-7);
-    EXPECT_NEAR(s.orientation.y(), 0.01374718, 2e-7);
-    EXPECT_NEAR(s.orientation.z(), -0.05691256, 2e-7);
+    expect_wxyz_near(s.orientation, 0.94455600, -0.32308814, 0.01374718, -0.05691256);
     EXPECT_TRUE(s.has_frame_counter);
     EXPECT_EQ(s.frame_counter, 18050u);
     EXPECT_EQ(s.flags, kHasDeviceTime);
@@ -249,13 +190,10 @@ TEST(XsensDecoder, RecordedMti300MessagesDecodeAsMtManagerDecodedThem) {
   }
   {
     // 11 packets, 139 data bytes: the quaternion sits among outputs the decoder skips.
-    const Result r = decode(message(0x36, hex(kMti300BreakdownData)));
+    const Decoded r = decode(message(0x36, hex(kMti300BreakdownData)));
     ASSERT_EQ(r.samples.size(), 1u);
     const DecodedSample& s = r.samples[0];
-    EXPECT_NEAR(s.orientation.w(), 0.99801278, 2e-7);
-    EXPECT_NEAR(s.orientation.x(), -0.00879299, 2e-7);
-    EXPECT_NEAR(s.orientation.y(), 0.00492375, 2e-7);
-    EXPECT_NEAR(s.orientation.z(), -0.06220087, 2e-7);
+    expect_wxyz_near(s.orientation, 0.99801278, -0.00879299, 0.00492375, -0.06220087);
     EXPECT_EQ(s.frame_counter, 42581u);
     EXPECT_DOUBLE_EQ(s.device_time, 571.9854);
     EXPECT_EQ(r.counters.malformed, 0u);
@@ -267,7 +205,7 @@ TEST(XsensDecoder, RecordedMti300MessagesDecodeAsMtManagerDecodedThem) {
 // ENU). A decoder that conjugated would map it onto -y.
 TEST(XsensDecoder, NoConjugateSensorToEarth) {
   const double h = std::sqrt(0.5);
-  const Result r = decode(encode_xsens_mtdata2(Quat(h, 0, 0, h), std::nullopt, std::nullopt));
+  const Decoded r = decode(encode_xsens_mtdata2(Quat(h, 0, 0, h), std::nullopt, std::nullopt));
   ASSERT_EQ(r.samples.size(), 1u);
   const Vec3 v = r.samples[0].orientation * Vec3::UnitX();
   EXPECT_NEAR(v.x(), 0.0, 1e-7);
@@ -298,12 +236,12 @@ TEST(XsensDecoder, RoundTripsRandomOrientations) {
     Bytes stream;
     std::vector<Quat> qs;
     for (int k = 0; k < 200; ++k) {
-      qs.push_back(random_unit(rng));
+      qs.push_back(random_unit_quaternion(rng));
       stream = cat({stream, encode_xsens_mtdata2(qs.back(), with_counter ? std::optional<std::uint16_t>(k) : std::nullopt,
                                                  with_time ? std::optional<std::uint32_t>(100 * k) : std::nullopt,
                                                  extended)});
     }
-    const Result r = decode(stream);
+    const Decoded r = decode(stream);
     ASSERT_EQ(r.samples.size(), qs.size()) << variant;
     EXPECT_EQ(r.counters.frames, qs.size());
     EXPECT_EQ(r.counters.skipped_bytes, 0u);
@@ -333,7 +271,7 @@ TEST(XsensDecoder, LongMessageWithExtendedLength) {
   ASSERT_GT(data.size(), 254u);
   const Bytes m = message(0x36, data);
   ASSERT_EQ(m[3], 0xFF);
-  const Result r = decode(m);
+  const Decoded r = decode(m);
   ASSERT_EQ(r.samples.size(), 1u);
   EXPECT_EQ(r.samples[0].orientation.coeffs(), q.coeffs());
   EXPECT_EQ(r.samples[0].frame_counter, 7u);
@@ -352,12 +290,12 @@ TEST(XsensDecoder, OtherPrecisionsAndEarthFrames) {
   const Bytes f32 = cat({be_float(0.5f), be_float(-0.5f), be_float(0.5f), be_float(-0.5f)});
   for (const auto& [id, payload] : std::vector<std::pair<std::uint16_t, Bytes>>{
            {0x2010, f32}, {0x2014, f32}, {0x2018, f32}, {0x2011, fp1220}, {0x2013, f64}, {0x201B, f64}}) {
-    const Result r = decode(message(0x36, packet(id, payload)));
+    const Decoded r = decode(message(0x36, packet(id, payload)));
     ASSERT_EQ(r.samples.size(), 1u) << std::hex << id;
     EXPECT_EQ(r.samples[0].orientation.coeffs(), q.coeffs()) << std::hex << id;
   }
   // Fixed point 16.32 is not decoded: a message whose only quaternion it is counts as ignored.
-  const Result r = decode(message(0x36, packet(0x2012, Bytes(24, 0))));
+  const Decoded r = decode(message(0x36, packet(0x2012, Bytes(24, 0))));
   EXPECT_EQ(r.samples.size(), 0u);
   EXPECT_EQ(r.counters.ignored_frames, 1u);
   EXPECT_EQ(r.counters.malformed, 0u);
@@ -377,14 +315,14 @@ TEST(XsensDecoder, ImpossibleContentsAreMalformed) {
       cat({packet(0x2010, unit), Bytes{0x10, 0x20, 0x02, 0x00}}),                                     // a packet beyond the data
   };
   for (std::size_t k = 0; k < bad.size(); ++k) {
-    const Result r = decode(cat({message(0x36, bad[k]), encode_xsens_mtdata2(Quat::Identity(), 5, 6)}));
+    const Decoded r = decode(cat({message(0x36, bad[k]), encode_xsens_mtdata2(Quat::Identity(), 5, 6)}));
     EXPECT_EQ(r.counters.frames, 2u) << k;
     EXPECT_EQ(r.counters.malformed, 1u) << k;
     ASSERT_EQ(r.samples.size(), 1u) << k;  // the next message decodes
     EXPECT_EQ(r.samples[0].frame_counter, 5u);
   }
   // Just inside the tolerance: accepted and normalised.
-  const Result ok = decode(message(0x36, packet(0x2010, cat({be_float(1.0009f), be_float(0), be_float(0), be_float(0)}))));
+  const Decoded ok = decode(message(0x36, packet(0x2010, cat({be_float(1.0009f), be_float(0), be_float(0), be_float(0)}))));
   ASSERT_EQ(ok.samples.size(), 1u);
   EXPECT_EQ(ok.samples[0].orientation.w(), 1.0);
 }
@@ -433,7 +371,7 @@ Stream make_stream(std::uint64_t seed, int messages) {
 
 TEST(XsensDecoder, AnySplitGivesTheSameSamplesAndCounters) {
   const Stream s = make_stream(11, 400);
-  const Result whole = decode(s.bytes);
+  const Decoded whole = decode(s.bytes);
   EXPECT_EQ(whole.counters.frames, s.good_frames);
   EXPECT_EQ(whole.counters.bytes, s.bytes.size());
   EXPECT_EQ(whole.counters.bytes - whole.counters.skipped_bytes, s.good_bytes);
@@ -441,33 +379,16 @@ TEST(XsensDecoder, AnySplitGivesTheSameSamplesAndCounters) {
   EXPECT_GT(whole.counters.resyncs, 0u);
   EXPECT_GT(whole.samples.size(), 300u);
 
-  expect_same(whole, decode_chunked(s.bytes, [] { return std::size_t{1}; }));
-  for (std::uint64_t seed : {1, 2, 3}) {
-    std::mt19937_64 rng(seed);
-    std::uniform_int_distribution<std::size_t> len(1, 97);
-    expect_same(whole, decode_chunked(s.bytes, [&] { return len(rng); }));
-  }
+  expect_byte_by_byte_same(make, s.bytes, whole);
+  expect_seeded_chunkings_same(make, s.bytes, whole, {1, 2, 3}, 97);
   // Every two-way split of a shorter stream.
   const Stream small = make_stream(5, 40);
-  const Result small_whole = decode(small.bytes);
-  for (std::size_t cut = 0; cut <= small.bytes.size(); ++cut) {
-    bool first = true;
-    const Result r = decode_chunked(small.bytes, [&] {
-      const std::size_t n = first ? cut : small.bytes.size();
-      first = false;
-      return n;
-    });
-    expect_same(small_whole, r);
-    if (::testing::Test::HasFailure()) {
-      ADD_FAILURE() << "cut at " << cut;
-      break;
-    }
-  }
+  expect_every_split_same(make, small.bytes, decode(small.bytes));
 }
 
 TEST(XsensDecoder, ResyncsAfterGarbage) {
   const Bytes good = encode_xsens_mtdata2(Quat::Identity(), 3, 4);
-  const Result r = decode(cat({{0x01, 0xFA, 0x02, 0xFA, 0xFA}, good, {0x00, 0x36}, good}));
+  const Decoded r = decode(cat({{0x01, 0xFA, 0x02, 0xFA, 0xFA}, good, {0x00, 0x36}, good}));
   EXPECT_EQ(r.samples.size(), 2u);
   EXPECT_EQ(r.counters.skipped_bytes, 7u);
   EXPECT_EQ(r.counters.resyncs, 2u);
@@ -478,7 +399,7 @@ TEST(XsensDecoder, BadChecksumIsCountedAndTheNextMessageDecodes) {
   Bytes bad = encode_xsens_mtdata2(Quat::Identity(), 1, 1);
   bad.back() ^= 0x01;
   const Bytes good = encode_xsens_mtdata2(Quat(0, 1, 0, 0), 2, 2);
-  const Result r = decode(cat({bad, good}));
+  const Decoded r = decode(cat({bad, good}));
   EXPECT_EQ(r.counters.bad_checksum, 1u);
   EXPECT_EQ(r.counters.frames, 1u);
   ASSERT_EQ(r.samples.size(), 1u);
@@ -495,7 +416,7 @@ TEST(XsensDecoder, MessageInsideAFalseCandidateIsFound) {
   const Bytes good = encode_xsens_mtdata2(Quat(0, 0, 1, 0), 2, 2);
   Bytes stream = cat({bad, good});
   while (stream.size() < 300) stream.push_back(0x00);
-  const Result r = decode(stream);
+  const Decoded r = decode(stream);
   EXPECT_EQ(r.counters.bad_checksum, 1u);
   ASSERT_EQ(r.samples.size(), 1u);
   EXPECT_EQ(r.samples[0].frame_counter, 2u);
@@ -546,7 +467,7 @@ TEST(XsensDecoder, PacketCounterAndSampleTimeFineRollOver) {
   const std::uint16_t counters[] = {65534, 65535, 0, 1, 65535, 3};
   const std::uint32_t times[] = {0xFFFFFFFEu, 0xFFFFFFFFu, 0u, 5u, 0xFFFFFFF0u, 0x10u};
   for (int k = 0; k < 6; ++k) stream = cat({stream, encode_xsens_mtdata2(Quat::Identity(), counters[k], times[k])});
-  const Result r = decode(stream);
+  const Decoded r = decode(stream);
   ASSERT_EQ(r.samples.size(), 6u);
   const std::uint64_t expected_counter[] = {65534, 65535, 65536, 65537, 131071, 131075};
   const std::uint64_t p32 = std::uint64_t{1} << 32;
@@ -562,29 +483,12 @@ TEST(XsensDecoder, PacketCounterAndSampleTimeFineRollOver) {
 // candidate); its checksum then matches by chance with probability 1/256.
 TEST(XsensDecoder, RandomBytesAcceptedWithinTheChecksumRate) {
   std::mt19937_64 rng(20240601);
-  auto d = make_xsens_decoder();
-  Collector c;
-  Bytes chunk(4096);
-  std::uint64_t candidates = 0;
-  std::uint8_t prev = 0;
-  for (std::size_t done = 0; done < 10'000'000; done += chunk.size()) {
-    for (auto& b : chunk) b = static_cast<std::uint8_t>(rng());
-    for (std::uint8_t b : chunk) {
-      candidates += prev == 0xFA && b == 0xFF;
-      prev = b;
-    }
-    d->feed(chunk, c);
-  }
-  const DecoderCounters& k = d->counters();
-  const double expected = static_cast<double>(candidates) / 256.0;
+  const auto [r, candidates] = decode_random_reads_of_4096(make(), rng, 0xFA, 0xFF);
+  const DecoderCounters& k = r.counters;
   EXPECT_GT(candidates, 100u);
-  EXPECT_LE(static_cast<double>(k.frames), expected + 6.0 * std::sqrt(expected) + 3.0)
-      << "candidates " << candidates << ", frames " << k.frames;
+  expect_poisson_at_most(k.frames, static_cast<double>(candidates) / 256.0, 3.0);
   EXPECT_GT(k.bad_checksum + k.malformed, candidates / 2);
-  for (const DecodedSample& s : c.samples) {
-    ASSERT_TRUE(s.orientation.coeffs().allFinite());
-    EXPECT_NEAR(s.orientation.norm(), 1.0, 1e-12);
-  }
+  expect_unit_quaternions(r.samples);
   EXPECT_LE(k.samples, k.frames);
 }
 

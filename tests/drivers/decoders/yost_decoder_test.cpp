@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "../../support/decoder_testing.hpp"
 #include "../../support/test_files.hpp"
 #include "posefair/core/so3.hpp"
 #include "posefair/drivers/yost_decoder.hpp"
@@ -26,42 +27,15 @@
 namespace posefair::drivers {
 namespace {
 
+using namespace ::posefair::testing;
 using Bytes = std::vector<std::uint8_t>;
 
-struct Recorder final : DecodedSink {
-  std::vector<DecodedSample> samples;
-  void on_sample(const DecodedSample& s) override { samples.push_back(s); }
-};
-
-struct Outcome {
-  std::vector<DecodedSample> samples;
-  DecoderCounters counters;
-};
-
-Outcome decode(const Bytes& stream, const std::vector<std::size_t>& chunks = {}, const DecoderOptions& options = {}) {
-  auto d = make_yost_decoder(options);
-  Recorder r;
-  std::size_t at = 0;
-  for (const std::size_t c : chunks) {
-    const std::size_t n = std::min(c, stream.size() - at);
-    d->feed({stream.data() + at, n}, r);
-    at += n;
-  }
-  d->feed({stream.data() + at, stream.size() - at}, r);
-  return {r.samples, d->counters()};
+// Feeds `stream` cut at the given chunk sizes (the rest as one last chunk).
+Decoded decode(const Bytes& stream, const std::vector<std::size_t>& chunks = {}, const DecoderOptions& options = {}) {
+  return decode_chunks(make_yost_decoder(options), stream, chunks);
 }
 
-Outcome decode_with(const Bytes& stream, const DecoderOptions& options) { return decode(stream, {}, options); }
-
-void expect_same(const Outcome& a, const Outcome& b, const std::string& what) {
-  EXPECT_EQ(a.counters, b.counters) << what;
-  ASSERT_EQ(a.samples.size(), b.samples.size()) << what;
-  for (std::size_t k = 0; k < a.samples.size(); ++k) {
-    EXPECT_EQ(a.samples[k].orientation.coeffs(), b.samples[k].orientation.coeffs()) << what << " " << k;
-    EXPECT_EQ(a.samples[k].flags, b.samples[k].flags) << what << " " << k;
-    EXPECT_EQ(a.samples[k].device_time, b.samples[k].device_time) << what << " " << k;
-  }
-}
+Decoded decode_with(const Bytes& stream, const DecoderOptions& options) { return decode(stream, {}, options); }
 
 Bytes operator+(Bytes a, const Bytes& b) {
   a.insert(a.end(), b.begin(), b.end());
@@ -84,7 +58,7 @@ const Bytes kAllFields = {0x00, 0x00, 0x00, 0x00, 0x05, 0xFF, 0xBF, 0x07, 0x12, 
 TEST(YostDecoder, ProtocolName) { EXPECT_EQ(make_yost_decoder({})->protocol(), "yost"); }
 
 TEST(YostDecoder, HandWrittenPacketsDecodeToTheirValues) {
-  const Outcome r = decode(kIdentity + kQuarterTurnZ);
+  const Decoded r = decode(kIdentity + kQuarterTurnZ);
   ASSERT_EQ(r.samples.size(), 2u);
   EXPECT_EQ(r.counters.frames, 2u);
   EXPECT_EQ(r.counters.skipped_bytes, 0u);
@@ -97,7 +71,7 @@ TEST(YostDecoder, HandWrittenPacketsDecodeToTheirValues) {
 
   DecoderOptions all;
   all.yost_header = "0x7F";
-  const Outcome a = decode_with(kAllFields, all);
+  const Decoded a = decode_with(kAllFields, all);
   ASSERT_EQ(a.samples.size(), 1u);
   EXPECT_DOUBLE_EQ(a.samples[0].device_time, 5e-6);
   EXPECT_EQ(a.counters.skipped_bytes, 0u);
@@ -135,7 +109,7 @@ TEST(YostRoundTrip, RandomOrientationsEveryHeaderVariant) {
     }
     DecoderOptions o;
     o.yost_header = std::to_string(f.header);
-    const Outcome r = decode_with(stream, o);
+    const Decoded r = decode_with(stream, o);
     ASSERT_EQ(r.samples.size(), truth.size()) << "header " << f.header;
     EXPECT_EQ(r.counters.skipped_bytes, 0u) << f.header;
     for (std::size_t k = 0; k < truth.size(); ++k) {
@@ -156,7 +130,7 @@ TEST(YostRoundTrip, FurtherStreamingSlotsAreSkipped) {
   DecoderOptions o;
   o.yost_data_length = "52";
   const Quat q = Quat(0.5, -0.5, 0.5, 0.5);
-  const Outcome r = decode_with(packet(q, 1, f) + packet(q, 2, f), o);
+  const Decoded r = decode_with(packet(q, 1, f) + packet(q, 2, f), o);
   ASSERT_EQ(r.samples.size(), 2u);
   EXPECT_LT(so3::rotation_angle(r.samples[1].orientation, q), 1e-7);
   // The default (16 data bytes) does not take these packets.
@@ -171,7 +145,7 @@ TEST(YostTimestamp, RolloverIsUnwrapped) {
                                            two32 + 0x80000000u, two32 + 0xFFFFFFFFu, 2 * two32, 2 * two32 + 5};
   Bytes stream;
   for (const std::uint32_t t : raw) stream = stream + packet(Quat::Identity(), t);
-  const Outcome r = decode(stream);
+  const Decoded r = decode(stream);
   ASSERT_EQ(r.samples.size(), raw.size());
   for (std::size_t k = 0; k < raw.size(); ++k) EXPECT_DOUBLE_EQ(r.samples[k].device_time, expected_us[k] * 1e-6) << k;
   for (std::size_t k = 1; k < raw.size(); ++k) EXPECT_GT(r.samples[k].device_time, r.samples[k - 1].device_time);
@@ -179,7 +153,7 @@ TEST(YostTimestamp, RolloverIsUnwrapped) {
 
 TEST(YostTimestamp, OtherBackwardStepsArePassedOnAndResetForgetsTheRollover) {
   auto d = make_yost_decoder({});
-  Recorder r;
+  Collector r;
   const auto feed = [&](std::uint32_t t) {
     const Bytes p = packet(Quat::Identity(), t);
     d->feed(p, r);
@@ -224,35 +198,29 @@ Bytes mixed_stream() {
 
 TEST(YostStream, AnySplitGivesIdenticalSamplesAndCounters) {
   const Bytes stream = mixed_stream();
-  const Outcome whole = decode(stream);
+  const Decoded whole = decode(stream);
   EXPECT_EQ(whole.samples.size(), 9u);
   EXPECT_EQ(whole.counters.ignored_frames, 1u);
   EXPECT_EQ(whole.counters.malformed, 1u);
   EXPECT_GE(whole.counters.bad_checksum, 1u);
   EXPECT_EQ(whole.counters.bytes, stream.size());
-  for (std::size_t cut = 0; cut <= stream.size(); ++cut) expect_same(whole, decode(stream, {cut}), "cut " + std::to_string(cut));
-  expect_same(whole, decode(stream, std::vector<std::size_t>(stream.size(), 1)), "byte by byte");
+  const auto make = [] { return make_yost_decoder({}); };
+  expect_every_split_same(make, stream, whole);
+  expect_byte_by_byte_same(make, stream, whole);
   std::mt19937_64 rng(4);
-  for (int trial = 0; trial < 300; ++trial) {
-    std::vector<std::size_t> chunks;
-    for (std::size_t at = 0; at < stream.size();) {
-      chunks.push_back(std::uniform_int_distribution<std::size_t>(0, 60)(rng));
-      at += chunks.back();
-    }
-    expect_same(whole, decode(stream, chunks), "trial " + std::to_string(trial));
-  }
+  expect_random_chunkings_same(make, stream, whole, rng, 300, {60});
 }
 
 TEST(YostResync, GarbageBeforeBetweenAndInsidePackets) {
   const Bytes garbage = {0x10, 0xFF, 0x00, 0x10, 0x42, 0xFF, 0x10};
   const Bytes good = packet(Quat(0.5, 0.5, 0.5, 0.5), 1234);
-  const Outcome r = decode(garbage + good + garbage + good);
+  const Decoded r = decode(garbage + good + garbage + good);
   EXPECT_EQ(r.samples.size(), 2u);
   EXPECT_EQ(r.counters.resyncs, 2u);
   EXPECT_EQ(r.counters.skipped_bytes, 2 * garbage.size());
   // A packet cut short by the next one: its bytes are skipped, the next decodes.
   const Bytes cut(good.begin(), good.begin() + 10);
-  const Outcome c = decode(cut + good);
+  const Decoded c = decode(cut + good);
   EXPECT_EQ(c.samples.size(), 1u);
   EXPECT_EQ(c.counters.skipped_bytes, cut.size());
 }
@@ -263,7 +231,7 @@ TEST(YostResync, BadChecksumIsCountedAndTheNextPacketDecodes) {
   const Bytes good = packet(Quat(0.5, 0.5, 0.5, 0.5), 1234);
   Bytes flipped = good;
   flipped[10] ^= 0x01;  // one data bit
-  const Outcome r = decode(packet(Quat::Identity(), 1, bad) + good + flipped + good);
+  const Decoded r = decode(packet(Quat::Identity(), 1, bad) + good + flipped + good);
   EXPECT_EQ(r.counters.bad_checksum, 2u);
   EXPECT_EQ(r.counters.frames, 2u);
   EXPECT_EQ(r.samples.size(), 2u);
@@ -279,7 +247,7 @@ TEST(YostFrames, FailureMalformedAndForeignPackets) {
   const Bytes stream = packet(Quat::Identity(), 1, failure) + packet(Quat(nan, 0, 0, 0), 2) + packet(Quat(0, 0, 0, 0), 3) +
                        packet(Quat(1.01, 0, 0, 0), 4) + packet(Quat::Identity(), 5, response) +
                        packet(Quat::Identity(), 6);
-  const Outcome r = decode(stream);
+  const Decoded r = decode(stream);
   EXPECT_EQ(r.counters.frames, 5u);
   EXPECT_EQ(r.counters.ignored_frames, 1u);
   EXPECT_EQ(r.counters.malformed, 3u);
@@ -321,11 +289,8 @@ TEST(YostRandom, RandomChecksumBytesAreAcceptedAtTheChecksumsRate) {
     const Bytes p = packet(Quat(0.6, 0.0, 0.0, 0.8), static_cast<std::uint32_t>(k), f);
     stream.insert(stream.end(), p.begin(), p.end());
   }
-  const Outcome r = decode(stream);
-  const double mean = kN / 256.0;
-  const double sd = std::sqrt(kN * (1.0 / 256) * (255.0 / 256));
-  EXPECT_LE(static_cast<double>(r.counters.frames), mean + 6 * sd);
-  EXPECT_GE(static_cast<double>(r.counters.frames), mean - 6 * sd);
+  const Decoded r = decode(stream);
+  expect_binomial_within(r.counters.frames, kN, 1.0 / 256);
   EXPECT_GE(r.counters.bad_checksum, kN - r.counters.frames);
 }
 
@@ -335,21 +300,11 @@ TEST(YostRandom, RandomChecksumBytesAreAcceptedAtTheChecksumsRate) {
 // P(> 8) < 1e-6).
 TEST(YostRandom, TenMegabytesOfRandomBytes) {
   std::mt19937_64 rng(1);
-  Bytes data(10'000'000);
-  for (auto& b : data) b = static_cast<std::uint8_t>(rng());
-  auto d = make_yost_decoder({});
-  Recorder r;
-  for (std::size_t at = 0; at < data.size();) {
-    const std::size_t n = std::min<std::size_t>(std::uniform_int_distribution<std::size_t>(1, 4096)(rng), data.size() - at);
-    d->feed({data.data() + at, n}, r);
-    at += n;
-  }
-  EXPECT_EQ(d->counters().bytes, data.size());
-  EXPECT_LE(d->counters().frames, 8u);
-  for (const DecodedSample& s : r.samples) {
-    EXPECT_TRUE(s.orientation.coeffs().allFinite());
-    EXPECT_NEAR(s.orientation.norm(), 1.0, 1e-12);
-  }
+  const Bytes data = random_bytes(10'000'000, rng);
+  const Decoded r = decode_in_random_reads(make_yost_decoder({}), data, rng);
+  EXPECT_EQ(r.counters.bytes, data.size());
+  EXPECT_LE(r.counters.frames, 8u);
+  expect_unit_quaternions(r.samples);
 }
 
 Bytes file(const std::string& name) {
@@ -360,12 +315,12 @@ Bytes file(const std::string& name) {
 // The fuzz seed corpus (tests/fuzz/corpus/yost/) is written by a separate generator (Python's
 // struct, not the encoder here): it must decode as intended.
 TEST(YostCorpus, SeedFilesDecodeAsIntended) {
-  const Outcome plain = decode(file("default_header.bin"));
+  const Decoded plain = decode(file("default_header.bin"));
   ASSERT_EQ(plain.samples.size(), 40u);
   EXPECT_EQ(plain.counters.skipped_bytes, 0u);
   for (std::size_t k = 0; k < plain.samples.size(); ++k)
     EXPECT_NEAR(plain.samples[k].device_time, 1.0 + 0.005 * static_cast<double>(k), 1e-12) << k;
-  const Outcome wrap = decode(file("rollover.bin"));
+  const Decoded wrap = decode(file("rollover.bin"));
   ASSERT_EQ(wrap.samples.size(), 12u);
   for (std::size_t k = 0; k < wrap.samples.size(); ++k)
     EXPECT_NEAR(wrap.samples[k].device_time, (0xFFFF0000u + 20000.0 * static_cast<double>(k)) * 1e-6, 1e-9) << k;
@@ -373,7 +328,7 @@ TEST(YostCorpus, SeedFilesDecodeAsIntended) {
   all.yost_header = "0x7F";
   all.yost_data_length = "20";
   EXPECT_EQ(decode_with(file("all_fields_len20.bin"), all).samples.size(), 12u);
-  const Outcome mixed = decode(file("mixed_garbage.bin"));
+  const Decoded mixed = decode(file("mixed_garbage.bin"));
   EXPECT_EQ(mixed.samples.size(), 6u);
   EXPECT_EQ(mixed.counters.ignored_frames, 1u);
   EXPECT_EQ(mixed.counters.malformed, 1u);

@@ -1,0 +1,103 @@
+#pragma once
+// The destination of a daemon::Pipeline's output in the in-process tests (pipeline_tests.cpp,
+// pipeline_alloc_tests.cpp): a UDP socket of the test's own on 127.0.0.1, drained by a thread
+// of its own from the start so the kernel's receive buffer never has to hold a whole run, and
+// every datagram decoded (daemon/wire_protocol.hpp). Also the tests' bounded wait.
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <span>
+#include <thread>
+#include <vector>
+
+#include "posefair/daemon/udp_socket.hpp"
+#include "posefair/daemon/wire_protocol.hpp"
+
+namespace posefair::testing {
+
+class UdpCollector {
+ public:
+  UdpCollector() {
+    daemon::ReceiveOptions ro;
+    ro.receive_buffer_bytes = 8 << 20;
+    socket_ = daemon::UdpSocket::bind(*daemon::Endpoint::parse("127.0.0.1:0"), ro);
+    thread_ = std::thread([this] { loop(); });
+  }
+  ~UdpCollector() { stop(); }
+  UdpCollector(const UdpCollector&) = delete;
+  UdpCollector& operator=(const UdpCollector&) = delete;
+
+  std::uint16_t port() const { return socket_.local_endpoint().port(); }
+
+  // Ends the thread once nothing has arrived for `quiet` (bounded by `limit` overall): the
+  // caller has stopped the pipeline, so whatever is still in flight is in the socket buffer.
+  void drain(std::chrono::milliseconds quiet = std::chrono::milliseconds(300),
+             std::chrono::milliseconds limit = std::chrono::seconds(10)) {
+    const auto deadline = std::chrono::steady_clock::now() + limit;
+    for (;;) {
+      const std::size_t before = datagrams();
+      std::this_thread::sleep_for(quiet);
+      if (datagrams() == before || std::chrono::steady_clock::now() > deadline) break;
+    }
+    stop();
+  }
+
+  // The datagrams that decoded, in arrival order.
+  std::vector<daemon::PoseMessage> messages() const {
+    std::lock_guard lock(mutex_);
+    return messages_;
+  }
+  // The datagrams that did not (truncated, or refused by the decoder).
+  std::size_t malformed() const {
+    std::lock_guard lock(mutex_);
+    return malformed_;
+  }
+  // Every datagram received.
+  std::size_t datagrams() const {
+    std::lock_guard lock(mutex_);
+    return messages_.size() + malformed_;
+  }
+
+ private:
+  void stop() {
+    stop_.store(true);
+    if (thread_.joinable()) thread_.join();
+  }
+  void loop() {
+    std::vector<std::uint8_t> buffer(daemon::kMaxDatagramSize + 1);
+    while (!stop_.load()) {
+      const auto d = socket_.receive(buffer, std::chrono::milliseconds(20));
+      if (!d) continue;
+      const daemon::DecodeResult r =
+          d->truncated ? daemon::rejected(daemon::DecodeError::kOversized, daemon::WireEncoding::kBinary)
+                       : daemon::decode_datagram(std::span<const std::uint8_t>(buffer.data(), d->size));
+      std::lock_guard lock(mutex_);
+      if (r.ok())
+        messages_.push_back(r.message);
+      else
+        ++malformed_;
+    }
+  }
+
+  daemon::UdpSocket socket_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  mutable std::mutex mutex_;
+  std::vector<daemon::PoseMessage> messages_;
+  std::size_t malformed_ = 0;
+};
+
+// Polls `done` every 5 ms until it holds (true) or `timeout` has passed (false).
+inline bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+}  // namespace posefair::testing
