@@ -24,6 +24,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -578,6 +579,63 @@ TEST(DaemonRecording, SigtermWhileRecordingThenReplayTheRecording) {
   EXPECT_EQ(rc->received, c->received) << rc->line;
   EXPECT_EQ(rc->dropped, 0u) << rc->line;
   EXPECT_EQ(rc->emitted, c->received) << rc->line;
+}
+
+// A reload that leaves [recorder] and the stream table alone keeps writing the same file (the
+// open writer is handed to the new pipeline): one recording holds the samples of both.
+TEST(DaemonRecording, SighupWithTheSameRecorderContinuesTheRecording) {
+  ScratchDir dir("posefair-e2e-");
+  const fs::path config = dir / "record.toml";
+  const std::string text =
+      "[logging]\nstatus_interval = 0\n\n"
+      "[[stream]]\nid = 4\nname = \"rec\"\n"
+      "driver = { type = \"synthetic\", rate_hz = 500.0, duration = 0.0 }\n\n"
+      "[recorder]\npath = \"both.pflog\"\nflush_interval = 0.2\n";
+  write_text(config, text);
+  Subprocess d(daemon_args(config), dir / "d.out", dir / "d.err");
+  ASSERT_TRUE(wait_for_log_or_exit(d, "started:", 20s)) << d.err();
+  std::this_thread::sleep_for(500ms);
+  d.send_signal(SIGHUP);
+  ASSERT_TRUE(wait_for_log_or_exit(d, "reloaded:", 15s)) << d.err();
+  std::this_thread::sleep_for(500ms);
+  d.send_signal(SIGTERM);
+  ASSERT_EQ(d.wait(20s), 0) << d.err();
+  // The counter lines: one when the first pipeline stopped at the reload, one at exit.
+  std::uint64_t received = 0, lines = 0;
+  for (const std::string& line : lines_of(d.err())) {
+    const auto at = line.find("stream rec (id 4, ");
+    if (at == std::string::npos) continue;
+    const auto r = line.find("): received ", at);
+    ASSERT_NE(r, std::string::npos) << line;
+    received += std::stoull(line.substr(r + 12));
+    ++lines;
+  }
+  ASSERT_EQ(lines, 2u) << d.err();
+  const drivers::SampleLogContents log = drivers::read_sample_log(dir / "both.pflog");
+  EXPECT_TRUE(log.stats.problems.empty());
+  EXPECT_EQ(log.samples.size(), received) << "one file holds every sample of both pipelines";
+  EXPECT_FALSE(fs::exists(dir / "both.1.pflog"));
+}
+
+// A '%' in the recorder's path is expanded by strftime, so a restarted service starts a new file.
+TEST(DaemonRecording, ATimePatternInTheRecorderPathNamesTheFile) {
+  ScratchDir dir("posefair-e2e-");
+  const fs::path config = dir / "record.toml";
+  write_text(config,
+             "[daemon]\nexit_when_sources_end = true\n[logging]\nstatus_interval = 0\n\n"
+             "[[stream]]\nid = 6\nname = \"rec\"\n"
+             "driver = { type = \"synthetic\", rate_hz = 1000.0, duration = 0.2 }\n\n"
+             "[recorder]\npath = \"run-%Y%m%d.pflog\"\nsync = false\n");
+  const std::time_t now = std::time(nullptr);
+  Subprocess d(daemon_args(config), dir / "d.out", dir / "d.err");
+  ASSERT_EQ(d.wait(30s), 0) << d.err();
+  std::tm local{};
+  ::localtime_r(&now, &local);
+  char name[64];
+  std::strftime(name, sizeof name, "run-%Y%m%d.pflog", &local);
+  ASSERT_TRUE(fs::exists(dir / name)) << "expected " << name << "; " << d.err();
+  EXPECT_FALSE(fs::exists(dir / "run-%Y%m%d.pflog"));
+  EXPECT_EQ(drivers::read_sample_log(dir / name).samples.size(), 200u);
 }
 
 TEST(DaemonRecording, ATruncatedRecordingIsPlayedUpToTheDamageWithAWarning) {
