@@ -5,6 +5,7 @@
 #include "devices_command.hpp"
 #include "exit_codes.hpp"
 #include "fair_command.hpp"
+#include "registered_commands.hpp"
 #include "reproduce_command.hpp"
 #include "sub_command.hpp"
 
@@ -18,6 +19,7 @@ int main(int argc, char** argv) {
   posefair::tools::add_bench_command(app, exit_code);
   posefair::tools::add_sub_command(app, exit_code);
   posefair::tools::add_devices_command(app, exit_code);
+  posefair::tools::add_registered_commands(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

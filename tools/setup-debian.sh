@@ -19,6 +19,7 @@ packages=(
   python3                # the Python subscriber client and its test
   zlib1g-dev             # CRC-32 of the sample log (drivers)
   libserialport-dev      # the serial driver: ports by path or USB id, settings (drivers)
+  libnlopt-cxx-dev       # the quaternion spline optimiser (core)
 )
 if [[ "${1:-}" == "--plots" ]]; then
   packages+=(python3 python3-matplotlib python3-numpy)
