@@ -304,6 +304,7 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.recorded = get(s.counters.recorded);
     st.record_dropped = s.record_ring ? s.record_ring->dropped() : 0;
     st.latency = s.counters.latency.snapshot();
+    st.device = s.driver->health();
     out.push_back(std::move(st));
   }
   return out;

@@ -18,6 +18,20 @@ double rate(std::uint64_t now, std::uint64_t before, double seconds) {
 
 double us(std::uint64_t ns) { return static_cast<double>(ns) / 1000.0; }
 
+// "; device connected, outages 1, reconnects 1, open failures 3, read errors 0, frames 2000,
+//  bad 2, resyncs 3 (skipped 41 bytes), device time trusted (fallbacks 0)"
+std::string device_text(const drivers::DeviceHealth& d) {
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                "; device %s, outages %" PRIu64 ", reconnects %" PRIu64 ", open failures %" PRIu64
+                ", read errors %" PRIu64 ", frames %" PRIu64 ", bad %" PRIu64 ", resyncs %" PRIu64
+                " (skipped %" PRIu64 " bytes), %s time (fallbacks %" PRIu64 ")",
+                d.connected ? "connected" : "DISCONNECTED", d.outages, d.reconnects, d.open_failures, d.read_errors,
+                d.frames, d.bad_frames, d.resyncs, d.skipped_bytes, d.device_time_trusted ? "device" : "receive",
+                d.time_fallbacks);
+  return buf;
+}
+
 }  // namespace
 
 std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, const std::vector<StreamStats>& previous,
@@ -39,6 +53,7 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
                   us(s.latency.percentile(50)), us(s.latency.percentile(90)), us(s.latency.percentile(99)),
                   us(s.latency.max));
     lines.emplace_back(buf);
+    if (s.device) lines.back() += device_text(*s.device);
   }
   return lines;
 }
@@ -52,6 +67,13 @@ std::string status_line(const std::vector<StreamStats>& now, const std::vector<S
     std::snprintf(buf, sizeof buf, "%s%s %.1f/s drop %" PRIu64 " p99 %.0fus", out.empty() ? "" : "; ", s.name.c_str(),
                   p ? rate(s.emitted, p->emitted, seconds) : 0.0, s.dropped(), us(interval.percentile(99)));
     out += buf;
+    // A device stream says when its device is away and how often it went: what `systemctl
+    // status` readers need first.
+    if (s.device) {
+      std::snprintf(buf, sizeof buf, "%s outages %" PRIu64 " bad %" PRIu64, s.device->connected ? "" : " DISCONNECTED",
+                    s.device->outages, s.device->bad_frames);
+      out += buf;
+    }
   }
   return out;
 }

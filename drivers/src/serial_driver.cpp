@@ -122,6 +122,23 @@ TimeBaseCounters SerialDriver::time_base_counters() const {
   return time_base_snapshot_;
 }
 
+std::optional<DeviceHealth> SerialDriver::health() const {
+  DeviceHealth h;
+  h.connected = connected();
+  h.outages = outages();
+  h.reconnects = reconnects();
+  h.open_failures = open_failures();
+  h.read_errors = read_errors();
+  const DecoderCounters d = decoder_counters();
+  h.frames = d.frames;
+  h.bad_frames = d.bad_checksum + d.malformed;
+  h.resyncs = d.resyncs;
+  h.skipped_bytes = d.skipped_bytes;
+  h.device_time_trusted = device_time_trusted();
+  h.time_fallbacks = time_base_fallbacks();
+  return h;
+}
+
 std::string SerialDriver::device_path() const {
   std::lock_guard lock(snapshot_mutex_);
   return device_path_;

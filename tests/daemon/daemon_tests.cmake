@@ -18,3 +18,9 @@ posefair_add_test(daemon_e2e_tests
   LIBS posefair::protocol posefair::drivers
   LABELS "daemon;network;e2e;threads")
 add_dependencies(daemon_e2e_tests posefaird posefair)
+
+# status_report_tests: the counter lines and STATUS= text, with and without a device link.
+posefair_add_test(status_report_tests
+  SOURCES status_report_tests.cpp
+  LIBS posefair::service
+  LABELS daemon)

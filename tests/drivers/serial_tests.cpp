@@ -26,6 +26,7 @@
 
 #include <gtest/gtest.h>
 
+#include "../support/pseudo_terminal.hpp"
 #include "../support/test_files.hpp"
 #include "posefair/drivers/serial_driver.hpp"
 #include "posefair/drivers/serial_port.hpp"
@@ -52,49 +53,7 @@ bool eventually(const std::function<bool()>& done, std::chrono::milliseconds lim
   return done();
 }
 
-// A pseudo-terminal: the test holds the master, the driver opens the slave by its path.
-class Pty {
- public:
-  Pty() {
-    master_ = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
-    if (master_ < 0) throw std::runtime_error(std::string("posix_openpt: ") + std::strerror(errno));
-    if (::grantpt(master_) != 0 || ::unlockpt(master_) != 0) throw std::runtime_error("grantpt/unlockpt failed");
-    char name[128];
-    if (::ptsname_r(master_, name, sizeof name) != 0) throw std::runtime_error("ptsname_r failed");
-    slave_ = name;
-    // Raw from the start, so nothing is echoed or edited before the driver configures it.
-    const int s = ::open(name, O_RDWR | O_NOCTTY | O_CLOEXEC);
-    if (s < 0) throw std::runtime_error(std::string("open slave: ") + std::strerror(errno));
-    termios t{};
-    ::tcgetattr(s, &t);
-    ::cfmakeraw(&t);
-    ::tcsetattr(s, TCSANOW, &t);
-    ::close(s);
-  }
-  Pty(const Pty&) = delete;
-  Pty& operator=(const Pty&) = delete;
-  ~Pty() { close(); }
-
-  const std::string& slave() const { return slave_; }
-  // Unplug: the slave's reader sees a hangup (EIO).
-  void close() {
-    if (master_ >= 0) ::close(master_);
-    master_ = -1;
-  }
-  void write(std::string_view bytes) const {
-    std::size_t done = 0;
-    while (done < bytes.size()) {
-      const ssize_t n = ::write(master_, bytes.data() + done, bytes.size() - done);
-      if (n < 0 && errno == EINTR) continue;
-      ASSERT_GT(n, 0) << std::strerror(errno);
-      done += static_cast<std::size_t>(n);
-    }
-  }
-
- private:
-  int master_ = -1;
-  std::string slave_;
-};
+using Pty = testing::PseudoTerminal;
 
 // Points `link` at `target`, atomically replacing what it pointed at (as udev re-points
 // /dev/serial/by-id links on a replug).
@@ -557,6 +516,15 @@ TEST(SerialDriver, UnplugAndReplugCountsOneOutageLogsOnceAndTheStreamContinues) 
   EXPECT_EQ(driver.decoder_counters().malformed, 0u);
   EXPECT_EQ(driver.outages(), 1u);
   EXPECT_EQ(driver.device_path(), std::filesystem::canonical(second.slave()).string());
+  // The same link state as the daemon's counter lines see it.
+  const std::optional<DeviceHealth> health = driver.health();
+  ASSERT_TRUE(health.has_value());
+  EXPECT_TRUE(health->connected);
+  EXPECT_EQ(health->outages, 1u);
+  EXPECT_EQ(health->reconnects, 1u);
+  EXPECT_EQ(health->open_failures, driver.open_failures());
+  EXPECT_EQ(health->frames, driver.decoder_counters().frames);
+  EXPECT_EQ(health->frames, 10u);
   EXPECT_LT(run.stop(), 100ms);
 
   // Opened, lost, reopened: one line each.

@@ -5,9 +5,11 @@
 // percentiles come from differences of snapshots.
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "posefair/daemon/latency_histogram.hpp"
+#include "posefair/drivers/driver.hpp"
 
 namespace posefair::daemon {
 
@@ -33,6 +35,7 @@ struct StreamStats {
   std::uint64_t received = 0, ring_dropped = 0, rejected = 0, out_of_order = 0, emitted = 0, clamped = 0, restarts = 0;
   std::uint64_t publish_dropped = 0, published = 0, send_failures = 0, recorded = 0, record_dropped = 0;
   HistogramSnapshot latency;
+  std::optional<drivers::DeviceHealth> device;  // the device link, for drivers that have one
   // Poses lost on the way to subscribers: overflow of the engine's and the publisher's rings.
   std::uint64_t dropped() const { return ring_dropped + publish_dropped; }
 };

@@ -83,6 +83,7 @@ class SerialDriver final : public Driver {
   TimeBaseCounters time_base_counters() const; // snapshot after the last read
   std::string device_path() const;             // the node opened last ("" before the first open)
   std::string_view protocol() const { return decoder_->protocol(); }
+  std::optional<DeviceHealth> health() const override;
 
  private:
   void log(LogLevel level, const std::string& message) const;

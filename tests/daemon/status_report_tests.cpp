@@ -1,0 +1,74 @@
+// The operator's text (status_report.hpp): counter lines and systemd's STATUS=, with and
+// without a device link.
+#include "posefair/daemon/status_report.hpp"
+
+#include <gtest/gtest.h>
+
+namespace posefair::daemon {
+namespace {
+
+StreamStats stream(std::uint32_t id, const std::string& name, std::uint64_t emitted) {
+  StreamStats s;
+  s.id = id;
+  s.name = name;
+  s.driver = "serial:/dev/ttyUSB0 (xsens)";
+  s.driver_running = true;
+  s.received = emitted;
+  s.emitted = emitted;
+  s.published = emitted;
+  return s;
+}
+
+drivers::DeviceHealth link(bool connected) {
+  drivers::DeviceHealth d;
+  d.connected = connected;
+  d.outages = 2;
+  d.reconnects = 1;
+  d.open_failures = 7;
+  d.read_errors = 3;
+  d.frames = 1990;
+  d.bad_frames = 4;
+  d.resyncs = 5;
+  d.skipped_bytes = 41;
+  d.device_time_trusted = true;
+  d.time_fallbacks = 6;
+  return d;
+}
+
+TEST(StatusReport, CounterLineWithoutDeviceHasNoDevicePart) {
+  const auto lines = counter_lines({stream(1, "head", 2000)}, {}, 0.0);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find("stream head (id 1, serial:/dev/ttyUSB0 (xsens)): received 2000,"), std::string::npos) << lines[0];
+  EXPECT_EQ(lines[0].find("device"), std::string::npos) << lines[0];
+}
+
+TEST(StatusReport, CounterLineCarriesEveryDeviceCounter) {
+  StreamStats s = stream(1, "head", 2000);
+  s.device = link(true);
+  const auto lines = counter_lines({s}, {}, 0.0);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find("; device connected, outages 2, reconnects 1, open failures 7, read errors 3, frames 1990, "
+                          "bad 4, resyncs 5 (skipped 41 bytes), device time (fallbacks 6)"),
+            std::string::npos)
+      << lines[0];
+  s.device->connected = false;
+  s.device->device_time_trusted = false;
+  const auto away = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(away[0].find("; device DISCONNECTED,"), std::string::npos) << away[0];
+  EXPECT_NE(away[0].find(", receive time (fallbacks 6)"), std::string::npos) << away[0];
+}
+
+TEST(StatusReport, StatusLineMarksADisconnectedDevice) {
+  StreamStats head = stream(1, "head", 2000);
+  head.device = link(false);
+  StreamStats prev_head = stream(1, "head", 1000);
+  StreamStats hand = stream(2, "hand", 500);
+  StreamStats prev_hand = stream(2, "hand", 0);
+  const std::string line = status_line({head, hand}, {prev_head, prev_hand}, 2.0);
+  EXPECT_EQ(line, "head 500.0/s drop 0 p99 0us DISCONNECTED outages 2 bad 4; hand 250.0/s drop 0 p99 0us");
+  head.device->connected = true;
+  EXPECT_EQ(status_line({head}, {prev_head}, 2.0), "head 500.0/s drop 0 p99 0us outages 2 bad 4");
+}
+
+}  // namespace
+}  // namespace posefair::daemon
