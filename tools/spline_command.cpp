@@ -159,6 +159,10 @@ void add_spline_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--accuracy", o->accuracy,
                   "add variable frames one at a time until one lowers the objective by less than this fraction")
       ->check(CLI::Range(1e-12, 1.0));
+  cmd->add_option("--frames-per-round", o->spline.frames_per_round,
+                  "variable frames added per refinement round before re-optimising")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
   (void)frames;
   cmd->add_option("--segments", o->spline.segments_per_interval, "Euler-Lagrange segments per keyframe interval")
       ->check(CLI::Range(2, 1000))
