@@ -121,8 +121,10 @@ int run_spline(SplineCommandOptions o) {
     std::fprintf(stderr,
                  "stage     %-26s objective %.8g (covariant %.8g)  EL error mean %.4g max %.4g  max| |q|-1 | %.3g  "
                  "%.3f ms  %d evaluations\n",
-                 !st.optimized ? "unoptimised" : st.variable_frames == 0 ? "velocities only"
-                                                 : (std::to_string(st.variable_frames) + " variable frames").c_str(),
+                 !st.optimized              ? "unoptimised"
+                 : st.variable_frames == 0  ? "velocities only"
+                 : st.variable_frames == 1  ? "1 variable frame"
+                                            : (std::to_string(st.variable_frames) + " variable frames").c_str(),
                  st.objective, st.covariant, st.mean_el_deviation, st.max_el_deviation, st.max_norm_deviation,
                  1e3 * st.seconds, st.evaluations);
   std::fprintf(stderr, "time      %.3f ms algorithm, %.3f ms with the statistics\n", 1e3 * r.stages.back().seconds, 1e3 * wall);
@@ -154,8 +156,8 @@ void add_spline_command(CLI::App& app, int& exit_code) {
       ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
   cmd->add_option("--rate", o->rate, "output samples per second")->check(CLI::Range(1e-6, 1e7))->capture_default_str();
   cmd->add_option("--alpha", o->spline.alpha, "weight of the soft unit-norm term")->check(CLI::PositiveNumber)->capture_default_str();
-  auto* frames = cmd->add_option("--frames", o->frames, "variable frames to insert (default 4; with --accuracy: a cap)")
-                     ->check(CLI::Range(0, 100000));
+  cmd->add_option("--frames", o->frames, "variable frames to insert (default 4; with --accuracy: a cap)")
+      ->check(CLI::Range(0, 100000));
   cmd->add_option("--accuracy", o->accuracy,
                   "add variable frames one at a time until one lowers the objective by less than this fraction")
       ->check(CLI::Range(1e-12, 1.0));
@@ -163,7 +165,6 @@ void add_spline_command(CLI::App& app, int& exit_code) {
                   "variable frames added per refinement round before re-optimising")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
-  (void)frames;
   cmd->add_option("--segments", o->spline.segments_per_interval, "Euler-Lagrange segments per keyframe interval")
       ->check(CLI::Range(2, 1000))
       ->capture_default_str();
