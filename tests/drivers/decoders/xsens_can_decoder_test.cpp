@@ -196,5 +196,25 @@ TEST(XsensCanDecoder, RandomFramesAreAcceptedAtTheGeometricRate) {
   for (const auto& s : r.samples) ASSERT_TRUE(std::isfinite(s.device_time));
 }
 
+// 10 MB of random quaternion frames (8 bytes each): accepted at the rate a random point of the
+// cube [-1, 1]^4 lies within 1e-3 of the unit sphere, π²/2 · (1.001⁴ − 0.999⁴) / 16 ≈ 0.25%
+// (about 3100 of 1.25 million, ± 55): a tolerance 20% wider or narrower would be caught.
+TEST(XsensCanDecoder, RandomQuaternionFramesPassTheNormCheckAtTheGeometricRate) {
+  std::mt19937_64 rng(101);
+  std::vector<CanFrame> frames = random_frames(1'250'000, {0x021}, rng);
+  std::uint64_t candidates = 0;  // no component -32768
+  for (auto& f : frames) {
+    f.len = 8;
+    bool ok = true;
+    for (int k = 0; ok && k < 4; ++k) ok = !(f.data[2 * k] == 0x80 && f.data[2 * k + 1] == 0x00);
+    candidates += ok;
+  }
+  const CanDecoded r = decode(frames);
+  const double p = std::numbers::pi * std::numbers::pi / 2.0 * (std::pow(1.001, 4) - std::pow(0.999, 4)) / 16.0;
+  expect_binomial_within(r.counters.samples, static_cast<double>(candidates), p);
+  EXPECT_EQ(r.counters.samples + r.counters.malformed, frames.size());
+  expect_unit_quaternions(r.samples);
+}
+
 }  // namespace
 }  // namespace posefair::drivers
