@@ -4,9 +4,15 @@
 // Run: build/tests/bench/quaternion_spline_bench
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <functional>
+#include <vector>
+
+#include "posefair/core/knot_velocity.hpp"
 #include "posefair/core/quaternion_spline.hpp"
 #include "posefair/core/quaternion_spline_example.hpp"
 #include "posefair/core/sampled_rotation_energy.hpp"
+#include "posefair/core/sphere_geometric_spline.hpp"
 
 namespace posefair {
 namespace {
@@ -55,13 +61,71 @@ void BM_ObjectiveAndGradient(benchmark::State& state) {
 }
 BENCHMARK(BM_ObjectiveAndGradient)->Unit(benchmark::kMicrosecond);
 
-// The slerp chain through the same keys, sampled at 100 Hz (601 samples): the cheap baseline.
-void BM_SlerpChain_100Hz(benchmark::State& state) {
-  const SplineKeyframes k = seven_keyframe_example();
-  const std::vector<double> t = uniform_times(0.0, 6.0, 0.01);
-  for (auto _ : state) benchmark::DoNotOptimize(slerp_chain(k.time, k.orientation, t));
+// Comparison on the same keys (docs/quaternion-splines.md): each curve built and sampled at
+// 100 Hz (601 samples); counters: the sampled covariant energy E_Δ at 100 Hz and 1000 Hz.
+void report_energy(benchmark::State& state, const std::function<std::vector<Quat>(const std::vector<double>&)>& sample) {
+  for (double rate : {100.0, 1000.0}) {
+    const std::vector<double> t = uniform_times(0.0, 6.0, 1.0 / rate);
+    state.counters[rate == 100.0 ? "energy_100Hz" : "energy_1000Hz"] = sampled_covariant_energy(sample(t), 1.0 / rate);
+  }
 }
-BENCHMARK(BM_SlerpChain_100Hz)->Unit(benchmark::kMicrosecond);
+
+void BM_Compare_SlerpChain(benchmark::State& state) {
+  const SplineKeyframes k = seven_keyframe_example();
+  auto sample = [&](const std::vector<double>& t) { return slerp_chain(k.time, k.orientation, t); };
+  const std::vector<double> t = uniform_times(0.0, 6.0, 0.01);
+  for (auto _ : state) benchmark::DoNotOptimize(sample(t));
+  report_energy(state, sample);
+}
+BENCHMARK(BM_Compare_SlerpChain)->Unit(benchmark::kMillisecond);
+
+// The C² geometric spline on S³ (Rodrigues, Silva Leite & Jakubiak, eq. 22, family
+// geometric_splines) through the same keys: zero velocity at the ends like the example,
+// interior knot velocities by the Bessel estimator on log coordinates.
+void BM_Compare_GeometricSplineC2(benchmark::State& state) {
+  using P = geometric_splines::SpherePoint<4>;
+  const SplineKeyframes k = seven_keyframe_example();
+  auto build = [&] {
+    std::vector<P> p;
+    for (const Quat& q : k.orientation) p.push_back(to_vec4(q));
+    std::vector<P> v(p.size(), P::Zero());
+    for (std::size_t i = 1; i + 1 < p.size(); ++i) {
+      const double dt[3] = {k.time[i - 1] - k.time[i], 0.0, k.time[i + 1] - k.time[i]};
+      const P x[3] = {geometric_splines::sphere_log<4>(p[i], p[i - 1]), P::Zero(),
+                      geometric_splines::sphere_log<4>(p[i], p[i + 1])};
+      v[i] = geometric_splines::estimate_knot_velocity<4>(geometric_splines::KnotVelocityEstimator::Bessel, dt, x);
+    }
+    return geometric_splines::SphereGeometricSpline<4>(k.time, p, v, 2);
+  };
+  auto sample = [](const geometric_splines::SphereGeometricSpline<4>& s, const std::vector<double>& t) {
+    std::vector<Quat> out;
+    out.reserve(t.size());
+    for (double x : t) out.push_back(to_quat(s.evaluate(std::min(x, s.end_time()))));
+    return out;
+  };
+  const std::vector<double> t = uniform_times(0.0, 6.0, 0.01);
+  for (auto _ : state) benchmark::DoNotOptimize(sample(build(), t));
+  const auto spline = build();
+  report_energy(state, [&](const std::vector<double>& times) { return sample(spline, times); });
+}
+BENCHMARK(BM_Compare_GeometricSplineC2)->Unit(benchmark::kMillisecond);
+
+// This optimiser (4 variable frames), built and sampled.
+void BM_Compare_CovariantSpline4Frames(benchmark::State& state) {
+  const SplineKeyframes k = seven_keyframe_example();
+  auto sample = [](const HermiteCurve4& c, const std::vector<double>& t) {
+    std::vector<Quat> out;
+    out.reserve(t.size());
+    for (double x : t) out.push_back(to_quat(c.position(x).normalized()));
+    return out;
+  };
+  const std::vector<double> t = uniform_times(0.0, 6.0, 0.01);
+  QuaternionSplineOptions o;
+  for (auto _ : state) benchmark::DoNotOptimize(sample(build_quaternion_spline(k, o).spline.curve, t));
+  const HermiteCurve4 curve = build_quaternion_spline(k, o).spline.curve;
+  report_energy(state, [&](const std::vector<double>& times) { return sample(curve, times); });
+}
+BENCHMARK(BM_Compare_CovariantSpline4Frames)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace posefair
