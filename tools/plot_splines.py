@@ -1,0 +1,81 @@
+#!/usr/bin/python3
+"""Plots for docs/splines.md: geometric C^k splines (k = 1, 2, 3) through a decimated real
+orientation stream, their angular velocity against the gyroscope, and their angular
+acceleration.
+
+    /usr/bin/python3 tools/plot_splines.py build/tools/posefair docs/img
+
+Data: BROAD trial 07 (fast rotation; Laidig et al. 2021, CC BY 4.0). The script writes every
+10th optical sample of a 3 s stretch (28.6 Hz knots) to a CSV, runs
+`posefair resample --rate 1000 --order k --derivatives` on it for k = 1, 2, 3 (the C++ code
+writes the body-frame angular velocity and acceleration CSV), and plots those against the
+trial's own 285.7 Hz gyroscope. Needs python3-matplotlib.
+"""
+import csv
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+DATA = Path(__file__).resolve().parent.parent.parent / "shared/data/broad/07_undisturbed_fast_rotation_B.csv"
+START, LENGTH, DECIMATE = 30.0, 3.0, 10
+
+
+def main():
+    posefair, out_dir = Path(sys.argv[1]), Path(sys.argv[2])
+    data = sys.argv[3] if len(sys.argv) > 3 else DATA
+    rows = []
+    with open(data, newline="") as f:
+        for r in csv.DictReader(f):
+            t = float(r["t_s"])
+            if START <= t <= START + LENGTH and r["gt_qw"] != "nan":
+                rows.append(r)
+    knots = rows[::DECIMATE]
+    gyro_t = [float(r["t_s"]) for r in rows]
+    gyro = [sum(float(r[f"gyr_{a}_rads"]) ** 2 for a in "xyz") ** 0.5 for r in rows]
+    curves = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        knot_file = Path(tmp) / "knots.csv"
+        with open(knot_file, "w") as f:
+            f.write("t,qw,qx,qy,qz\n")
+            for r in knots:
+                f.write(",".join([r["t_s"], r["gt_qw"], r["gt_qx"], r["gt_qy"], r["gt_qz"]]) + "\n")
+        for k in (1, 2, 3):
+            deriv = Path(tmp) / f"k{k}.csv"
+            subprocess.run([str(posefair), "resample", str(knot_file), "-o", str(Path(tmp) / f"out{k}.csv"),
+                            "--rate", "1000", "--order", str(k), "--derivatives", str(deriv), "-q"], check=True)
+            with open(deriv, newline="") as f:
+                d = list(csv.DictReader(f))
+            curves[k] = ([float(r["t"]) for r in d], [float(r["w_norm"]) for r in d], [float(r["a_norm"]) for r in d])
+    knot_t = [float(r["t_s"]) for r in knots]
+    fig, (ax_w, ax_a) = plt.subplots(2, 1, figsize=(10, 7), sharex=True)
+    ax_w.plot(gyro_t, gyro, color="0.6", lw=2.5, label="gyroscope (285.7 Hz)")
+    colors = {1: "tab:blue", 2: "tab:orange", 3: "tab:green"}
+    for k, (t, w, a) in curves.items():
+        ax_w.plot(t, w, color=colors[k], lw=1, label=f"spline k={k}")
+        ax_a.plot(t, a, color=colors[k], lw=1, label=f"spline k={k}")
+    for t in knot_t:
+        ax_w.axvline(t, color="0.85", lw=0.5, zorder=0)
+        ax_a.axvline(t, color="0.85", lw=0.5, zorder=0)
+    ax_w.set_ylabel("|angular velocity| (rad/s)")
+    ax_a.set_ylabel("|angular acceleration| (rad/s²)")
+    ax_a.set_xlabel("time (s); grey lines: knots (every 10th optical sample, 28.6 Hz)")
+    ax_w.set_title("Geometric splines on S³ through BROAD trial 07 optical orientation (bessel knot velocities)")
+    ax_w.legend(loc="upper right", fontsize=8)
+    ax_a.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out_dir / "splines-k123.png", dpi=110)
+    # A close-up of one second.
+    ax_w.set_xlim(START + 1.0, START + 2.0)
+    fig.savefig(out_dir / "splines-k123-zoom.png", dpi=110)
+    print(f"wrote {out_dir / 'splines-k123.png'} and {out_dir / 'splines-k123-zoom.png'}")
+
+
+if __name__ == "__main__":
+    main()
