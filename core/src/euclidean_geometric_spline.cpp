@@ -80,14 +80,13 @@ EuclideanGeometricSpline<N>::EuclideanGeometricSpline(std::vector<EuclideanKnot<
       if (d.size() != dim) throw std::invalid_argument(where + "dimension differs from knot 0");
     if (i > 0 && !(k.time > knots_[i - 1].time))
       throw std::invalid_argument(where + "time does not increase");
+    times_.push_back(k.time);
   }
 }
 
 template <int N>
 std::size_t EuclideanGeometricSpline<N>::segment_index(double t) const {
-  std::vector<double> times(knots_.size());
-  for (std::size_t i = 0; i < knots_.size(); ++i) times[i] = knots_[i].time;
-  return find_segment(times, t);
+  return find_segment(times_, t);
 }
 
 template <int N>

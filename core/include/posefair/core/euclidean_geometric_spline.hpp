@@ -57,6 +57,7 @@ class EuclideanGeometricSpline {
 
  private:
   std::vector<EuclideanKnot<N>> knots_;
+  std::vector<double> times_;  // knots_[i].time, for the segment search
   SmoothingFunction phi_;
 };
 
