@@ -38,7 +38,7 @@ def main():
     knots = rows[::DECIMATE]
     gyro_t = [float(r["t_s"]) for r in rows]
     gyro = [sum(float(r[f"gyr_{a}_rads"]) ** 2 for a in "xyz") ** 0.5 for r in rows]
-    curves = {}
+    curves, vectors = {}, {}
     with tempfile.TemporaryDirectory() as tmp:
         knot_file = Path(tmp) / "knots.csv"
         with open(knot_file, "w") as f:
@@ -52,7 +52,22 @@ def main():
             with open(deriv, newline="") as f:
                 d = list(csv.DictReader(f))
             curves[k] = ([float(r["t"]) for r in d], [float(r["w_norm"]) for r in d], [float(r["a_norm"]) for r in d])
+            vectors[k] = [[float(r[f"w{a}"]) for a in "xyz"] for r in d]
     knot_t = [float(r["t_s"]) for r in knots]
+    # Body-frame angular velocity against the gyroscope (same body frame), at the gyro's
+    # samples inside the knots' range (the 1 kHz spline output, nearest sample).
+    for k, (t, _, _) in curves.items():
+        err2, n = 0.0, 0
+        for r in rows:
+            tg = float(r["t_s"])
+            if not t[0] <= tg <= t[-1]:
+                continue
+            j = min(range(max(0, int((tg - t[0]) * 1000) - 1), min(len(t), int((tg - t[0]) * 1000) + 2)),
+                    key=lambda i: abs(t[i] - tg))
+            g = [float(r[f"gyr_{a}_rads"]) for a in "xyz"]
+            err2 += sum((vectors[k][j][c] - g[c]) ** 2 for c in range(3))
+            n += 1
+        print(f"k={k}: RMS |w_spline - w_gyro| = {(err2 / n) ** 0.5:.3f} rad/s over {n} gyro samples")
     fig, (ax_w, ax_a) = plt.subplots(2, 1, figsize=(10, 7), sharex=True)
     ax_w.plot(gyro_t, gyro, color="0.6", lw=2.5, label="gyroscope (285.7 Hz)")
     colors = {1: "tab:blue", 2: "tab:orange", 3: "tab:green"}
