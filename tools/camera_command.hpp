@@ -1,0 +1,8 @@
+#pragma once
+#include <CLI/CLI.hpp>
+
+namespace posefair::tools {
+// `posefair camera`: camera keyframes -> interpolated camera matrices per frame by Alexa's
+// linear combination of transformations (docs/matrix-interpolation.md).
+void add_camera_command(CLI::App& app, int& exit_code);
+}
