@@ -25,7 +25,7 @@ Quat random_unit(std::mt19937& rng) {
 
 Vec4 as_vec4(const Quat& q) { return Vec4(q.w(), q.x(), q.y(), q.z()); }
 
-TEST(GaussLegendreRule, IntegratesPolynomialsUpToDegreeTwoNMinusOneExactly) {
+TEST(QuaternionSplineQuadrature, IntegratesPolynomialsUpToDegreeTwoNMinusOneExactly) {
   for (int n = 1; n <= 10; ++n) {
     const QuadratureRule r = gauss_legendre_rule(n);
     for (int degree = 0; degree <= 2 * n; ++degree) {
@@ -52,7 +52,7 @@ HermiteCurve4 random_curve(std::mt19937& rng, int nodes) {
   return HermiteCurve4(n);
 }
 
-TEST(HermiteCurve4, InterpolatesNodePositionsAndVelocities) {
+TEST(QuaternionSplineHermiteCurve, InterpolatesNodePositionsAndVelocities) {
   std::mt19937 rng(1);
   const HermiteCurve4 c = random_curve(rng, 5);
   for (std::size_t i = 0; i < c.nodes().size(); ++i) {
@@ -66,7 +66,7 @@ TEST(HermiteCurve4, InterpolatesNodePositionsAndVelocities) {
   }
 }
 
-TEST(HermiteCurve4, DerivativesMatchFiniteDifferences) {
+TEST(QuaternionSplineHermiteCurve, DerivativesMatchFiniteDifferences) {
   std::mt19937 rng(2);
   const HermiteCurve4 c = random_curve(rng, 3);
   const double t = c.nodes()[0].time + 0.37 * (c.nodes()[1].time - c.nodes()[0].time), h = 1e-5;
@@ -76,7 +76,7 @@ TEST(HermiteCurve4, DerivativesMatchFiniteDifferences) {
   EXPECT_LT((j.d3 - (b.d2 - a.d2) / (2 * h)).norm(), 1e-8);
 }
 
-TEST(HermiteCurve4, SplittingAPieceLeavesTheCurveUnchanged) {
+TEST(QuaternionSplineHermiteCurve, SplittingAPieceLeavesTheCurveUnchanged) {
   std::mt19937 rng(3);
   HermiteCurve4 c = random_curve(rng, 4);
   const HermiteCurve4 before = c;
@@ -90,7 +90,7 @@ TEST(HermiteCurve4, SplittingAPieceLeavesTheCurveUnchanged) {
   EXPECT_THROW(c.split_at(c.nodes()[1].time), std::invalid_argument);
 }
 
-TEST(HermiteCurve4, RejectsTimesThatDoNotIncrease) {
+TEST(QuaternionSplineHermiteCurve, RejectsTimesThatDoNotIncrease) {
   std::vector<HermiteNode> n(3);
   n[0].time = 0;
   n[1].time = 1;
@@ -99,7 +99,7 @@ TEST(HermiteCurve4, RejectsTimesThatDoNotIncrease) {
   EXPECT_THROW(HermiteCurve4{std::vector<HermiteNode>(1)}, std::invalid_argument);
 }
 
-TEST(ObjectiveIntegrand, PartialsMatchFiniteDifferences) {
+TEST(QuaternionSplineIntegrand, PartialsMatchFiniteDifferences) {
   std::mt19937 rng(4);
   for (int trial = 0; trial < 20; ++trial) {
     const Vec4 q = random_vec4(rng), q2 = random_vec4(rng);
@@ -115,7 +115,7 @@ TEST(ObjectiveIntegrand, PartialsMatchFiniteDifferences) {
   }
 }
 
-TEST(ObjectiveIntegrand, CovariantPartIsTheTangentialAccelerationSquared) {
+TEST(QuaternionSplineIntegrand, CovariantPartIsTheTangentialAccelerationSquared) {
   // ERRATA 1: the projection divides by q·q. On any circle through the origin's plane traversed
   // at unit rate, q″ = −q is purely normal, whatever |q| is; the printed q·q′ (= 0 there) would
   // divide by zero.
@@ -146,7 +146,7 @@ CurveJet great_circle(const Quat& l, const Quat& r, double omega, double t) {
   return j;
 }
 
-TEST(EulerLagrange, VanishesOnGreatCircles) {
+TEST(QuaternionSplineEulerLagrange, VanishesOnGreatCircles) {
   std::mt19937 rng(6);
   for (int trial = 0; trial < 20; ++trial) {
     const Quat l = random_unit(rng), r = random_unit(rng);
@@ -158,7 +158,7 @@ TEST(EulerLagrange, VanishesOnGreatCircles) {
   }
 }
 
-TEST(EulerLagrange, DoesNotVanishOffGreatCircles) {
+TEST(QuaternionSplineEulerLagrange, DoesNotVanishOffGreatCircles) {
   // A small circle on the unit sphere, (cos φ cos t, cos φ sin t, sin φ, 0): unit norm, constant
   // speed, but its acceleration has a tangential part, so it is not optimal.
   const double phi = 0.4;
@@ -178,7 +178,7 @@ TEST(EulerLagrange, DoesNotVanishOffGreatCircles) {
   EXPECT_LT((euler_lagrange_vector(big, alpha) - 4 * alpha * (1.01 * 1.01 - 1) * big.q).norm(), 1e-9);
 }
 
-TEST(EulerLagrange, MatchesNumericalDifferentiationOnACubic) {
+TEST(QuaternionSplineEulerLagrange, MatchesNumericalDifferentiationOnACubic) {
   // EL = ∂F/∂q + d²/dt² ∂F/∂q″ with the second derivative taken numerically along a cubic
   // piece: checks T′, T″ of eqs. 8–9 and the qT″ of eq. 6 (ERRATA 2).
   std::mt19937 rng(7);

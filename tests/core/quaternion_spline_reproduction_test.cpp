@@ -44,7 +44,7 @@ double optimum_estimate() {
   return value;
 }
 
-TEST(Reproduction, EachStageLowersTheObjectiveLikeFigure3) {
+TEST(QuaternionSplineReproduction, EachStageLowersTheObjectiveLikeFigure3) {
   const auto& st = four_frames().stages;
   ASSERT_EQ(st.size(), 6u);  // no optimisation, velocities only, 1..4 variable frames
   EXPECT_FALSE(st[0].optimized);
@@ -58,7 +58,7 @@ TEST(Reproduction, EachStageLowersTheObjectiveLikeFigure3) {
   EXPECT_LT(st[1].objective, 0.5 * st[0].objective);
 }
 
-TEST(Reproduction, FourVariableFramesAreWithinOnePercentOfTheOptimum) {
+TEST(QuaternionSplineReproduction, FourVariableFramesAreWithinOnePercentOfTheOptimum) {
   const double optimum = optimum_estimate();
   const double four = four_frames().stages.back().objective;
   const double gap = (four - optimum) / optimum;
@@ -72,7 +72,7 @@ TEST(Reproduction, FourVariableFramesAreWithinOnePercentOfTheOptimum) {
   EXPECT_LT((all - optimum) / optimum, 5e-4);
 }
 
-TEST(Reproduction, UnitNormIsKeptWithinThePapersBounds) {
+TEST(QuaternionSplineReproduction, UnitNormIsKeptWithinThePapersBounds) {
   const auto& st = four_frames().stages;
   EXPECT_GT(st[0].max_norm_deviation, 0.03);   // the unoptimised path: 4.5 %
   EXPECT_LT(st.back().max_norm_deviation, 0.01);  // α = 1000, 4 frames: under 1 % (0.26 %)
@@ -85,13 +85,13 @@ TEST(Reproduction, UnitNormIsKeptWithinThePapersBounds) {
   EXPECT_LT(r.stages.back().max_norm_deviation, 7e-4);  // paper: 0.07 %; here 0.022 %
 }
 
-TEST(Reproduction, EulerLagrangeErrorDropsWithOptimisation) {
+TEST(QuaternionSplineReproduction, EulerLagrangeErrorDropsWithOptimisation) {
   const auto& st = four_frames().stages;
   EXPECT_LT(st.back().mean_el_deviation, 0.2 * st[0].mean_el_deviation);
   EXPECT_LT(st.back().max_el_deviation, 0.2 * st[0].max_el_deviation);
 }
 
-TEST(Reproduction, KeyframesStayAndVariableFramesSitBetweenThem) {
+TEST(QuaternionSplineReproduction, KeyframesStayAndVariableFramesSitBetweenThem) {
   const QuaternionSplineResult& r = four_frames();
   const SplineKeyframes keys = seven_keyframe_example();
   std::size_t key = 0;
@@ -111,7 +111,7 @@ TEST(Reproduction, KeyframesStayAndVariableFramesSitBetweenThem) {
   EXPECT_EQ(r.spline.curve.nodes().back().velocity, Vec4::Zero());
 }
 
-TEST(Reproduction, TheZeroComponentStaysZero) {
+TEST(QuaternionSplineReproduction, TheZeroComponentStaysZero) {
   // The objective is symmetric under z -> −z, so its gradient has no z part: the path stays on
   // the 2-sphere of the keyframes, as in the paper's Fig. 1.
   const HermiteCurve4& c = all_segment_frames().spline.curve;

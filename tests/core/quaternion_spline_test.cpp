@@ -13,7 +13,7 @@
 namespace posefair {
 namespace {
 
-TEST(SplineObjective, QuadratureHasConverged) {
+TEST(QuaternionSplineObjective, QuadratureHasConverged) {
   const QuaternionSpline s = initial_spline(seven_keyframe_example());
   const double eight = SplineObjective(1000.0, 8).value(s.curve);
   const double thirty = SplineObjective(1000.0, 30).value(s.curve);
@@ -49,7 +49,7 @@ void expect_gradient_matches_finite_differences(HermiteCurve4 curve, double alph
   EXPECT_LT(worst, 1e-6);
 }
 
-TEST(SplineObjective, AnalyticGradientMatchesFiniteDifferences) {
+TEST(QuaternionSplineObjective, AnalyticGradientMatchesFiniteDifferences) {
   QuaternionSpline s = initial_spline(seven_keyframe_example());
   expect_gradient_matches_finite_differences(s.curve, 1000.0);
   // With variable frames and uneven pieces, after an optimisation.
@@ -60,7 +60,7 @@ TEST(SplineObjective, AnalyticGradientMatchesFiniteDifferences) {
   expect_gradient_matches_finite_differences(r.spline.curve, 0.0);
 }
 
-TEST(InitialSpline, CentralDifferencesInsideOneSidedAtFreeEnds) {
+TEST(QuaternionSplineInitial, CentralDifferencesInsideOneSidedAtFreeEnds) {
   SplineKeyframes k = seven_keyframe_example();
   k.time = {0.0, 1.0, 2.5, 3.0, 4.0, 5.0, 7.0};
   k.omega_start.reset();
@@ -77,7 +77,7 @@ TEST(InitialSpline, CentralDifferencesInsideOneSidedAtFreeEnds) {
   EXPECT_EQ(s.free_parameters(), 7 * 4);
 }
 
-TEST(InitialSpline, EndAngularVelocitiesBecomeQuaternionVelocities) {
+TEST(QuaternionSplineInitial, EndAngularVelocitiesBecomeQuaternionVelocities) {
   SplineKeyframes k = seven_keyframe_example();
   k.omega_start = Vec3(0.5, -1.0, 2.0);
   k.omega_end = Vec3(0.0, 0.3, 0.0);
@@ -93,7 +93,7 @@ TEST(InitialSpline, EndAngularVelocitiesBecomeQuaternionVelocities) {
   EXPECT_EQ(s.free_parameters(), 5 * 4);
 }
 
-TEST(InitialSpline, KeysAreNormalisedAndPutInOneHemisphere) {
+TEST(QuaternionSplineInitial, KeysAreNormalisedAndPutInOneHemisphere) {
   SplineKeyframes k;
   k.time = {0.0, 1.0, 2.0};
   k.orientation = {Quat(2, 0, 0, 0), Quat(-0.9, -0.1, 0, 0), Quat(0.8, 0.2, 0, 0)};
@@ -103,7 +103,7 @@ TEST(InitialSpline, KeysAreNormalisedAndPutInOneHemisphere) {
   EXPECT_GT(s.curve.nodes()[1].position.dot(s.curve.nodes()[2].position), 0.0);
 }
 
-TEST(InitialSpline, RejectsBadKeyframes) {
+TEST(QuaternionSplineInitial, RejectsBadKeyframes) {
   SplineKeyframes k;
   k.time = {0.0};
   k.orientation = {Quat::Identity()};
@@ -116,7 +116,7 @@ TEST(InitialSpline, RejectsBadKeyframes) {
   EXPECT_THROW(initial_spline(k), std::invalid_argument);
 }
 
-TEST(OptimizeSpline, KeepsKeyframesAndGivenEndVelocitiesAndLowersTheObjective) {
+TEST(QuaternionSplineOptimize, KeepsKeyframesAndGivenEndVelocitiesAndLowersTheObjective) {
   SplineKeyframes k = seven_keyframe_example();
   k.omega_end = Vec3(0.2, 0.1, 0.0);
   QuaternionSpline s = initial_spline(k);
@@ -136,7 +136,7 @@ TEST(OptimizeSpline, KeepsKeyframesAndGivenEndVelocitiesAndLowersTheObjective) {
   for (std::size_t i = 1; i + 1 < s.curve.nodes().size(); ++i) EXPECT_LT(g.d_velocity[i].norm(), 1e-3) << i;
 }
 
-TEST(OptimizeSpline, LbfgsAndSlsqpReachTheSameOptimum) {
+TEST(QuaternionSplineOptimize, LbfgsAndSlsqpReachTheSameOptimum) {
   for (int frames : {0, 4}) {
     QuaternionSplineOptions o;
     o.variable_frames = frames;
@@ -150,7 +150,7 @@ TEST(OptimizeSpline, LbfgsAndSlsqpReachTheSameOptimum) {
   }
 }
 
-TEST(Refinement, SegmentsCutEveryKeyIntervalEvenly) {
+TEST(QuaternionSplineRefinement, SegmentsCutEveryKeyIntervalEvenly) {
   const std::vector<double> t{0.0, 1.0, 3.0};
   const auto s = refinement_segments(t, 4);
   ASSERT_EQ(s.size(), 8u);
@@ -161,7 +161,7 @@ TEST(Refinement, SegmentsCutEveryKeyIntervalEvenly) {
   EXPECT_DOUBLE_EQ(s[7].end, 3.0);
 }
 
-TEST(Refinement, FramesGoToTheWorstSegmentsAwayFromKeyframes) {
+TEST(QuaternionSplineRefinement, FramesGoToTheWorstSegmentsAwayFromKeyframes) {
   QuaternionSpline s = initial_spline(seven_keyframe_example());
   const auto segments = refinement_segments(seven_keyframe_example().time, 5);
   std::vector<double> dev(segments.size(), 0.0);
@@ -186,7 +186,7 @@ TEST(Refinement, FramesGoToTheWorstSegmentsAwayFromKeyframes) {
   EXPECT_EQ(s.variable_frames(), 24);
 }
 
-TEST(Refinement, TargetImprovementStopsEarly) {
+TEST(QuaternionSplineRefinement, TargetImprovementStopsEarly) {
   QuaternionSplineOptions o;
   o.variable_frames = 24;
   o.target_improvement = 1e-3;
@@ -200,7 +200,7 @@ TEST(Refinement, TargetImprovementStopsEarly) {
     EXPECT_GE(r.stages[i - 1].objective - r.stages[i].objective, 1e-3 * r.stages[i].objective) << i;
 }
 
-TEST(SampledEnergy, SlerpChainCornersGrowLikeOneOverDt) {
+TEST(QuaternionSplineSampledEnergy, SlerpChainCornersGrowLikeOneOverDt) {
   const SplineKeyframes k = seven_keyframe_example();
   auto energy = [&](double dt) {
     const auto t = uniform_times(0.0, 6.0, dt);
@@ -213,7 +213,7 @@ TEST(SampledEnergy, SlerpChainCornersGrowLikeOneOverDt) {
   EXPECT_LT(sampled_covariant_energy(slerp_chain(k.time, k.orientation, t), 0.01), 1e-8);
 }
 
-TEST(SampledEnergy, ApproachesTheContinuousCovariantPartOnTheOptimisedSpline) {
+TEST(QuaternionSplineSampledEnergy, ApproachesTheContinuousCovariantPartOnTheOptimisedSpline) {
   QuaternionSplineOptions o;
   o.variable_frames = 4;
   const QuaternionSplineResult r = build_quaternion_spline(seven_keyframe_example(), o);

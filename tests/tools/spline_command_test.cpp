@@ -32,7 +32,7 @@ std::string q(const std::filesystem::path& p) {
   return s;
 }
 
-TEST(SplineCommand, ExampleFileIsTheCoreExample) {
+TEST(QuaternionSplineCommand, ExampleFileIsTheCoreExample) {
   ScratchDir dir;
   const auto out = dir / "out.txt";
   const auto r = run_posefair("spline '" + kExample + "' -o " + q(out) + " --frames 0 --rate 1", dir);
@@ -46,7 +46,7 @@ TEST(SplineCommand, ExampleFileIsTheCoreExample) {
   }
 }
 
-TEST(SplineCommand, WritesTheSampledCurveAndReportsTheStages) {
+TEST(QuaternionSplineCommand, WritesTheSampledCurveAndReportsTheStages) {
   ScratchDir dir;
   const auto out = dir / "curve.txt", stages = dir / "stages.csv", trace = dir / "trace.csv";
   const auto r = run_posefair("spline '" + kExample + "' -o " + q(out) + " --rate 50 --frames 4 --compare --stages-csv " +
@@ -79,7 +79,7 @@ TEST(SplineCommand, WritesTheSampledCurveAndReportsTheStages) {
   EXPECT_EQ(std::count(tr.begin(), tr.end(), '\n'), 302);
 }
 
-TEST(SplineCommand, CsvOutputTumInputAndEndVelocities) {
+TEST(QuaternionSplineCommand, CsvOutputTumInputAndEndVelocities) {
   ScratchDir dir;
   const auto in = dir / "keys.tum", out = dir / "curve.csv";
   // TUM layout (w last), an end angular velocity, commas and comments.
@@ -101,7 +101,7 @@ TEST(SplineCommand, CsvOutputTumInputAndEndVelocities) {
   EXPECT_LT(so3::rotation_angle(s.orientation[5], Quat(0.968912421711, 0.247403959255, 0, 0)), 1e-9);
 }
 
-TEST(SplineCommand, AccuracyAddsFramesUntilTheyStopPayingOff) {
+TEST(QuaternionSplineCommand, AccuracyAddsFramesUntilTheyStopPayingOff) {
   ScratchDir dir;
   const auto out = dir / "out.txt";
   const auto r = run_posefair("spline '" + kExample + "' -o " + q(out) + " --accuracy 0.001", dir);
@@ -117,9 +117,9 @@ struct BadFile {
   const char* expected;  // in the error message, after "<file>:"
 };
 
-class SplineBadKeyframes : public ::testing::TestWithParam<BadFile> {};
+class QuaternionSplineBadKeyframes : public ::testing::TestWithParam<BadFile> {};
 
-TEST_P(SplineBadKeyframes, ExitsWithDataErrorNamingFileAndLine) {
+TEST_P(QuaternionSplineBadKeyframes, ExitsWithDataErrorNamingFileAndLine) {
   ScratchDir dir;
   const auto in = dir / "keys.txt";
   write_text(in, GetParam().text);
@@ -132,7 +132,7 @@ TEST_P(SplineBadKeyframes, ExitsWithDataErrorNamingFileAndLine) {
 }
 
 INSTANTIATE_TEST_SUITE_P(
-    Cases, SplineBadKeyframes,
+    Cases, QuaternionSplineBadKeyframes,
     ::testing::Values(
         BadFile{"non_increasing", "0 1 0 0 0\n1 1 0 0 0\n# c\n1 1 0 0 0\n", "4: time 1 does not increase"},
         BadFile{"decreasing", "0 1 0 0 0\n2 1 0 0 0\n1 1 0 0 0\n", "3: time 1 does not increase"},
@@ -145,7 +145,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadFile{"omega", "0 1 0 0 0\nomega_end 1 2\n1 1 0 0 0\n", "2: omega_end needs three values"}),
     [](const auto& info) { return std::string(info.param.name); });
 
-TEST(SplineCommand, MissingInputAndBadOptions) {
+TEST(QuaternionSplineCommand, MissingInputAndBadOptions) {
   ScratchDir dir;
   auto r = run_posefair("spline " + q(dir / "nope.txt") + " -o " + q(dir / "out.txt"), dir);
   EXPECT_EQ(r.exit_code, 66);
