@@ -16,6 +16,20 @@ const MatrixResult& KeyframeInterpolator::log_of(int key, int origin) {
   return it->second;
 }
 
+std::optional<MatrixError> KeyframeInterpolator::check_steps() const {
+  for (std::size_t i = 0; i + 1 < matrices_.size(); ++i) {
+    const Mat4 rel = matrices_[i + 1] * origins_[i].inverse();
+    if (rotational_component(rel) >= options_.max_step_angle) {
+      MatrixResult r = log_about(matrices_[i + 1], origins_[i], options_);  // the message
+      MatrixError e = r ? MatrixError{MatrixErrorCode::UnsafeStep, "unsafe step"} : r.error();
+      e.key = static_cast<int>(i + 1);
+      e.origin_key = static_cast<int>(i);
+      return e;
+    }
+  }
+  return std::nullopt;
+}
+
 MatrixResult KeyframeInterpolator::frame(const FrameWeights& w) {
   Mat4 sum = Mat4::Zero();
   for (const WeightTerm& t : w.terms) {
@@ -42,6 +56,7 @@ Result<std::vector<Mat4>> interpolate_keyframes(InterpolationMethod method, std:
                                                 std::span<const double> frame_times, const CombinationOptions& o) {
   KeyframeInterpolator ki(std::vector<Mat4>(matrices.begin(), matrices.end()),
                           std::vector<Mat4>(origins.begin(), origins.end()), o);
+  if (auto e = ki.check_steps()) return *e;
   std::vector<Mat4> out;
   out.reserve(frame_times.size());
   for (const FrameWeights& w : frame_weights(method, key_times, frame_times)) {

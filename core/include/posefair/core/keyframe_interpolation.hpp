@@ -5,6 +5,7 @@
 // perspective factor P_b stays in the logarithm (eq. 7). Logarithms are cached per
 // (key, origin) pair, so a frame costs one exponential once its keys have been seen.
 #include <map>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -19,6 +20,9 @@ class KeyframeInterpolator {
   KeyframeInterpolator(std::vector<Mat4> matrices, std::vector<Mat4> origins = {}, CombinationOptions o = {});
   // The frame, or an error naming the key (and the origin key) that failed.
   MatrixResult frame(const FrameWeights& w);
+  // Section 3.2: every step from a key to the next, about the first, must rotate by less than
+  // max_step_angle, whatever frames are asked for. The error names the later key.
+  std::optional<MatrixError> check_steps() const;
   std::size_t size() const { return matrices_.size(); }
 
  private:
