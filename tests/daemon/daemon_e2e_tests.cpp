@@ -37,6 +37,8 @@
 #include <vector>
 
 #include "../protocol/subprocess.hpp"
+#include "../replay/replay_log.hpp"
+#include "../support/pseudo_terminal.hpp"
 #include "../support/test_files.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
@@ -881,6 +883,63 @@ TEST(DaemonSystemd, NotifiesReadyStatusWatchdogAndStoppingAndLogsCountersOnSigus
   const std::vector<std::string> last = notify.drain(200ms);
   EXPECT_TRUE(std::any_of(last.begin(), last.end(), [](const std::string& m) { return m.find("STOPPING=1") != std::string::npos; }))
       << "no STOPPING=1 at SIGTERM";
+}
+
+}  // namespace
+}  // namespace posefair::testing
+
+// ---------------------------------------------------------------------------------------------
+// 9. A serial device: a golden replay log (tests/replay/) written into a pseudo-terminal that
+//    the daemon's serial stream opens through a symlink, at the device's pace; the device's
+//    link appears in the counter line and in STATUS=, and an unplug is counted and reported.
+
+namespace posefair::testing {
+namespace {
+
+TEST(DaemonSerial, AGoldenLogThroughAPtyIsFairedAndTheLinkIsReported) {
+  ScratchDir dir("posefair-e2e-");
+  Collector poses;
+  const replay::ReplayLog log = replay::read_replay_log(fs::path(POSEFAIR_SOURCE_DIR) / "tests/replay/posefair-text.log");
+  auto pty = std::make_unique<PseudoTerminal>();
+  const fs::path link = dir / "ttyPF";
+  fs::create_symlink(pty->slave(), link);
+  const fs::path config = dir / "posefaird.toml";
+  write_text(config, "[logging]\nstatus_interval = 0\n\n[[stream]]\nid = 1\nname = \"imu\"\n"
+                     "driver = { type = \"serial\", device = \"" + link.string() +
+                     "\", protocol = \"posefair\", reconnect_min = 0.05, reconnect_max = 0.2 }\n\n"
+                     "[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(poses.port()) + "\"]\n");
+  NotifySocket notify(dir / "notify.sock");
+  ::setenv("NOTIFY_SOCKET", (dir / "notify.sock").c_str(), 1);
+  Subprocess d(daemon_args(config), dir / "d.out", dir / "d.err");
+  ::unsetenv("NOTIFY_SOCKET");
+  ASSERT_TRUE(wait_for_log_or_exit(d, "opened ", 10s)) << d.err();
+
+  // 300 frames at about 95 Hz, as the device would send them.
+  const std::size_t chunk = log.data.size() / 300 + 1;
+  for (std::size_t at = 0; at < log.data.size(); at += chunk) {
+    pty->write(std::string_view(log.data).substr(at, chunk));
+    std::this_thread::sleep_for(10ms);
+  }
+  // The .chk says 288 samples survive the log's faults; all but the lag's tail are faired.
+  ASSERT_TRUE(wait_until([&] { return poses.count(1) >= 280 || !d.running(); }, 10s)) << d.err();
+  d.send_signal(SIGUSR1);
+  ASSERT_TRUE(wait_for_log_or_exit(d, "; device connected, outages 0, reconnects 0", 5s)) << d.err();
+  EXPECT_NE(d.err().find("stream imu (id 1, serial:" + link.string() + " (posefair)): received 288 ("), std::string::npos)
+      << d.err();
+  EXPECT_NE(d.err().find(", frames 288, bad 9, resyncs 14 (skipped 3871 bytes)"), std::string::npos) << d.err();
+
+  // Unplug: the stream stays, the outage is logged once and shown in STATUS= and the counters.
+  pty.reset();
+  ASSERT_TRUE(wait_for_log_or_exit(d, "stream 'imu': lost the device", 5s)) << d.err();
+  const std::vector<std::string> messages = notify.drain(2500ms);
+  EXPECT_TRUE(std::any_of(messages.begin(), messages.end(), [](const std::string& m) {
+    return m.rfind("STATUS=imu ", 0) == 0 && m.find(" DISCONNECTED outages 1 bad 9") != std::string::npos;
+  })) << "no STATUS= with the outage; got " << messages.size() << " messages";
+  d.send_signal(SIGUSR1);
+  ASSERT_TRUE(wait_for_log_or_exit(d, "; device DISCONNECTED, outages 1, reconnects 0", 5s)) << d.err();
+  EXPECT_TRUE(d.running());
+  d.send_signal(SIGTERM);
+  EXPECT_EQ(d.wait(15s), 0) << d.err();
 }
 
 }  // namespace
