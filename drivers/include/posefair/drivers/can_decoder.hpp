@@ -1,0 +1,128 @@
+#pragma once
+// A CAN device protocol decoder: frames in, samples out. The CAN counterpart of decoder.hpp:
+// the same DecodedSample, DecodedSink and DecoderCounters, but fed one whole frame at a time
+// (a CAN controller delivers frames, never a byte stream, so there is nothing to resynchronise
+// within a frame; what can go wrong is lost, repeated or foreign frames, and for multi-frame
+// protocols a transfer left incomplete). Pure like the serial decoders: no I/O, no clock (time
+// comes with the frame), no allocation after construction, never throws on any frame.
+//
+// One file per protocol in drivers/src/, opening with a comment that names its reference
+// document and quirks; can_decoder_registry.cpp lists them (one line per protocol).
+//
+// Counters. DecoderCounters keeps its meaning per valid protocol message:
+//   bytes          payload bytes of the data frames addressed to this decoder (ids it reads)
+//   frames         valid messages: a frame whose length and contents passed the checks, or a
+//                  multi-frame transfer whose CRC matched (each decoder says which)
+//   samples        samples handed to the sink
+//   bad_checksum   multi-frame transfers whose CRC did not match
+//   malformed      addressed frames or transfers with a wrong length or impossible contents
+//   ignored_frames valid messages without an orientation (status, or a time left unused)
+//   resyncs        partial sets or transfers given up (lost frames, the sequence moved on)
+//   skipped_bytes  payload bytes that went into no valid message (malformed frames, parts of
+//                  given-up sets or transfers, stray continuation frames)
+// and CanFrameCounters counts the frames themselves, including those not addressed here.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "posefair/drivers/can_frame.hpp"
+#include "posefair/drivers/decoder.hpp"
+
+namespace posefair::drivers {
+
+// A kernel receive filter, as struct can_filter (linux/can.h): a frame passes when
+// (frame.can_id & mask) == (id & mask). id and mask include the canid_t flags, so a filter can
+// ask for extended frames only and refuse remote frames.
+struct CanFilter {
+  std::uint32_t id = 0;
+  std::uint32_t mask = 0;
+  bool matches(std::uint32_t can_id) const { return (can_id & mask) == (id & mask); }
+  friend bool operator==(const CanFilter&, const CanFilter&) = default;
+};
+
+struct CanFrameCounters {
+  std::uint64_t received = 0;  // every frame fed
+  std::uint64_t foreign = 0;   // data frames with an identifier this decoder does not read
+  std::uint64_t remote = 0;    // remote (RTR) frames
+  std::uint64_t errors = 0;    // error frames (kErrFlag); the driver logs their classes
+  friend bool operator==(const CanFrameCounters&, const CanFrameCounters&) = default;
+};
+
+// Choices per protocol that the device's configuration decides (each decoder's comment says
+// which it reads and what its default is). Strings, as in DecoderOptions, keep the config layer
+// simple: numbers in decimal or 0x hex.
+struct CanDecoderOptions {
+  // posefair-can (docs/can-protocol.md): the base identifier B (frames B, B+1, B+2) and its
+  // format, "standard" (11-bit) or "extended" (29-bit).
+  std::string posefair_base_id = "0x200";
+  std::string posefair_id_format = "standard";
+  // xsens-can: the identifiers the MTi was set to send its messages with (MT Manager's CAN
+  // output configuration; defaults: the data identifiers), their format, and the unit of
+  // SampleTime: "100us" (10 kHz ticks, Xsens' current CAN documentation) or "1us".
+  std::string xsens_quaternion_id = "0x021";
+  std::string xsens_sample_time_id = "0x005";
+  std::string xsens_group_counter_id = "0x006";
+  std::string xsens_id_format = "standard";
+  std::string xsens_sample_time_unit = "100us";
+  // dronecan-ahrs: the source node id to read (1..127), or "any": every node's transfers
+  // (reassembled per node; the samples of several nodes would interleave in one stream).
+  std::string dronecan_node_id = "any";
+};
+
+class CanDecoder {
+ public:
+  virtual ~CanDecoder() = default;
+  // The protocol's registry name, e.g. "xsens-can".
+  virtual std::string_view protocol() const = 0;
+  // The kernel filters that pass every frame this decoder reads (and as few others as they
+  // can); the SocketCAN driver sets them with CAN_RAW_FILTER. Error frames are asked for
+  // separately (CAN_RAW_ERR_FILTER).
+  virtual std::vector<CanFilter> filters() const = 0;
+
+  // One frame, in bus order. Error and remote frames and frames with identifiers this decoder
+  // does not read are counted and otherwise ignored; the rest are decoded, and every sample
+  // they complete goes to sink.
+  void feed(const CanFrame& frame, DecodedSink& sink) {
+    ++frame_counters_.received;
+    if (frame.error()) {
+      ++frame_counters_.errors;
+    } else if (frame.remote()) {
+      ++frame_counters_.remote;
+    } else if (!reads(frame)) {
+      ++frame_counters_.foreign;
+    } else {
+      counters_.bytes += frame.len;
+      decode(frame, sink);
+    }
+  }
+  // Forgets partial sets and transfers and any rollover state (after the bus was reopened).
+  virtual void reset() = 0;
+
+  const DecoderCounters& counters() const { return counters_; }
+  const CanFrameCounters& frame_counters() const { return frame_counters_; }
+
+ protected:
+  // Whether `frame` (a data frame) carries an identifier this decoder reads.
+  virtual bool reads(const CanFrame& frame) const = 0;
+  // Decodes a data frame that reads() accepted.
+  virtual void decode(const CanFrame& frame, DecodedSink& sink) = 0;
+
+  DecoderCounters counters_;
+  CanFrameCounters frame_counters_;
+};
+
+// The registry: nullptr for an unknown protocol name. Throws std::invalid_argument for an
+// option value the protocol does not accept (the message names the option).
+std::unique_ptr<CanDecoder> make_can_decoder(std::string_view protocol, const CanDecoderOptions& options = {});
+// Every registered CAN protocol name, sorted.
+std::vector<std::string> can_decoder_protocols();
+
+// Reads an identifier option: decimal or 0x hex, at most `max`. Throws std::invalid_argument
+// naming `option` otherwise.
+std::uint32_t parse_can_id_option(std::string_view option, std::string_view text, std::uint32_t max);
+// Reads an id format option, "standard" or "extended" (true). Throws as above.
+bool parse_can_id_format_option(std::string_view option, std::string_view text);
+
+}  // namespace posefair::drivers

@@ -1,0 +1,25 @@
+#pragma once
+// posefair's own CAN layout for microcontroller trackers (docs/can-protocol.md): a quaternion
+// frame (four int16) and optional device-time and position frames tied by a sequence counter.
+// Registry name: "posefair-can".
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "posefair/drivers/can_decoder.hpp"
+
+namespace posefair::drivers {
+
+// Reads posefair_base_id and posefair_id_format of CanDecoderOptions.
+std::unique_ptr<CanDecoder> make_posefair_can_decoder(const CanDecoderOptions& options = {});
+
+// What a sender puts on the bus for one sample, in the order it sends it: the time frame (when
+// device_time_us is given), the position frame (when position is given; metres, rounded to mm),
+// then the quaternion frame (q rounded to int16 / 32767). `sequence` goes into the time and
+// position frames. Identifiers base, base + 1, base + 2.
+std::vector<CanFrame> encode_posefair_can(std::uint32_t base_id, bool extended, const Quat& q,
+                                          std::optional<std::uint32_t> device_time_us,
+                                          const Vec3* position, std::uint8_t sequence, double timestamp = 0.0);
+
+}  // namespace posefair::drivers

@@ -1,0 +1,190 @@
+// Xsens/Movella MTi CAN output (MTi 600-series, Avior, Sirius): registry name "xsens-can".
+//
+// Reference documents
+// - Xsens, "MT CAN Protocol Documentation", MTi 600-series, document MT1604P, revision A
+//   (16 Sept 2019), and its current online form, Movella's "CAN Messages" page
+//   (mtidocs.movella.com/canmessages): the message list. Each message is one classic CAN frame
+//   (at most 8 bytes, up to 1 Mbit/s) with an 11- or 29-bit identifier; by default the
+//   identifier is the message's data identifier; MT Manager (SetCanOutputConfig) can change
+//   each identifier and the format.
+//     XCID_Error       0x001  uint8 error code
+//     XCID_SampleTime  0x005  uint32; Xbus equivalent XDI_SampleTimeFine (see the choice below)
+//     XCID_GroupCounter 0x006 uint16; a CAN group counter, independent of the Xbus PacketCounter
+//     XCDI_Quaternion  0x021  q0, q1, q2, q3: int16 each, 8 bytes
+// - Xsens' SDK header xscandataidentifier.h (enum XsCanDataIdentifier, shipped in the MT SDK
+//   sources) for the identifier values.
+// - Byte order: big-endian, as all Xsens binary data ("MTi User Manual" MT0605P.E 5.7.1).
+// - Scale: value = raw / 32767 (factor 3.05185094759972e-05 in Xsens' .dbc for the 600-series,
+//   as quoted by users of that file; Movella's page notes to "be careful when converting the
+//   value 1": 1.0 is 0x7FFF, -1.0 is 0x8001). The decoder normalises the quaternion, so the
+//   choice between 1/32767 and 1/32768 changes no sample.
+//
+// What posefair reads and the choices where the documents are open
+// - q0 is the scalar (Xsens' q_LS rotates sensor coordinates into the local earth frame,
+//   ENU by default): posefair's convention, no conjugate.
+// - SampleTime: Movella's current page says 10 kHz ticks (100 µs, like XDI_SampleTimeFine);
+//   the SDK header's comment says µs. Option xsens_sample_time_unit: "100us" (default) or
+//   "1us". Unwrapped forward-only at 2^32. GroupCounter: u16, unwrapped into frame_counter.
+// - Pairing: an MTi sends the messages of one output group one after the other, the timestamp
+//   messages first (their identifiers are lower, so they also win arbitration). A quaternion
+//   frame takes the SampleTime and GroupCounter received since the previous quaternion frame;
+//   a newer one of the same kind replaces an older one (which counts as ignored). A quaternion
+//   without them is a sample without device time / counter. Every valid SampleTime advances
+//   the unwrapping.
+// - Checks: the DLC must be 8, 4 and 2 (malformed otherwise; the documents fix each message's
+//   size). A quaternion with a component -32768 (outside ±1), or whose norm differs from 1 by
+//   more than 1e-3 (an int16-rounded unit quaternion is within 3e-5), is malformed; otherwise it
+//   is normalised. Only the three configured identifiers (in the configured format) are read;
+//   every other frame on the bus is foreign.
+// - No checksum in the payload: the CAN frame's CRC-15 protects it on the bus.
+#include "posefair/drivers/xsens_can_decoder.hpp"
+
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "posefair/drivers/byte_order.hpp"
+#include "posefair/drivers/counter_unwrap.hpp"
+
+namespace posefair::drivers {
+namespace {
+
+constexpr std::uint32_t kDefaultQuaternion = 0x021, kDefaultSampleTime = 0x005, kDefaultGroupCounter = 0x006;
+constexpr double kScale = 32767.0;
+constexpr double kUnitTolerance = 1e-3;
+
+struct XsensIds {
+  std::uint32_t quaternion, sample_time, group_counter;
+  bool extended;
+};
+
+class XsensCanDecoder final : public CanDecoder {
+ public:
+  XsensCanDecoder(const XsensIds& ids, double tick) : ids_(ids), tick_(tick) {}
+
+  std::string_view protocol() const override { return "xsens-can"; }
+
+  std::vector<CanFilter> filters() const override {
+    const std::uint32_t flag = ids_.extended ? CanFrame::kEffFlag : 0u;
+    const std::uint32_t mask = (ids_.extended ? CanFrame::kEffMask : CanFrame::kSffMask) | CanFrame::kEffFlag | CanFrame::kRtrFlag;
+    return {{ids_.sample_time | flag, mask}, {ids_.group_counter | flag, mask}, {ids_.quaternion | flag, mask}};
+  }
+
+  void reset() override {
+    time_.reset();
+    counter_.reset();
+    pending_time_.reset();
+    pending_counter_.reset();
+  }
+
+ protected:
+  bool reads(const CanFrame& f) const override {
+    const std::uint32_t id = f.id();
+    return f.extended() == ids_.extended && (id == ids_.quaternion || id == ids_.sample_time || id == ids_.group_counter);
+  }
+
+  void decode(const CanFrame& f, DecodedSink& sink) override {
+    const std::uint32_t id = f.id();
+    if (id == ids_.quaternion) {
+      quaternion(f, sink);
+    } else if (id == ids_.sample_time) {
+      if (f.len != 4) return malformed(f.len);
+      ++counters_.frames;
+      if (pending_time_) ++counters_.ignored_frames;
+      pending_time_ = time_.update(bytes::be_u32(f.data.data()));
+    } else {
+      if (f.len != 2) return malformed(f.len);
+      ++counters_.frames;
+      if (pending_counter_) ++counters_.ignored_frames;
+      pending_counter_ = counter_.update(bytes::be_u16(f.data.data()));
+    }
+  }
+
+ private:
+  void malformed(std::size_t len) {
+    ++counters_.malformed;
+    counters_.skipped_bytes += len;
+  }
+
+  void quaternion(const CanFrame& f, DecodedSink& sink) {
+    if (f.len != 8) return malformed(f.len);
+    std::array<double, 4> c{};
+    for (std::size_t k = 0; k < 4; ++k) {
+      const std::int16_t v = bytes::be_i16(&f.data[2 * k]);
+      if (v == -32768) return malformed(f.len);
+      c[k] = v / kScale;
+    }
+    const Quat q(c[0], c[1], c[2], c[3]);
+    const double n = q.norm();
+    if (!(std::abs(n - 1.0) <= kUnitTolerance)) return malformed(f.len);
+    ++counters_.frames;
+    DecodedSample s;
+    s.orientation = Quat(q.coeffs() / n);
+    if (pending_time_) {
+      s.flags |= kHasDeviceTime;
+      s.device_time = static_cast<double>(*pending_time_) * tick_;
+    }
+    if (pending_counter_) {
+      s.frame_counter = *pending_counter_;
+      s.has_frame_counter = true;
+    }
+    pending_time_.reset();
+    pending_counter_.reset();
+    ++counters_.samples;
+    sink.on_sample(s);
+  }
+
+  XsensIds ids_;
+  double tick_;
+  CounterUnwrapper time_{32};
+  CounterUnwrapper counter_{16};
+  std::optional<std::uint64_t> pending_time_;
+  std::optional<std::uint64_t> pending_counter_;
+};
+
+}  // namespace
+
+std::unique_ptr<CanDecoder> make_xsens_can_decoder(const CanDecoderOptions& o) {
+  XsensIds ids{};
+  ids.extended = parse_can_id_format_option("xsens_id_format", o.xsens_id_format);
+  const std::uint32_t max = ids.extended ? CanFrame::kEffMask : CanFrame::kSffMask;
+  ids.quaternion = parse_can_id_option("xsens_quaternion_id", o.xsens_quaternion_id, max);
+  ids.sample_time = parse_can_id_option("xsens_sample_time_id", o.xsens_sample_time_id, max);
+  ids.group_counter = parse_can_id_option("xsens_group_counter_id", o.xsens_group_counter_id, max);
+  if (ids.quaternion == ids.sample_time || ids.quaternion == ids.group_counter || ids.sample_time == ids.group_counter)
+    throw std::invalid_argument("xsens_quaternion_id, xsens_sample_time_id and xsens_group_counter_id must differ");
+  double tick = 0;
+  if (o.xsens_sample_time_unit == "100us")
+    tick = 1e-4;
+  else if (o.xsens_sample_time_unit == "1us")
+    tick = 1e-6;
+  else
+    throw std::invalid_argument("xsens_sample_time_unit: \"" + o.xsens_sample_time_unit + "\" is not \"100us\" or \"1us\"");
+  return std::make_unique<XsensCanDecoder>(ids, tick);
+}
+
+std::vector<CanFrame> encode_xsens_can(const Quat& q, std::optional<std::uint32_t> sample_time,
+                                       std::optional<std::uint16_t> group_counter, double timestamp) {
+  std::vector<CanFrame> frames;
+  if (group_counter) {
+    std::array<std::uint8_t, 2> d{};
+    bytes::put_be_u16(d.data(), *group_counter);
+    frames.push_back(CanFrame::make(kDefaultGroupCounter, false, d, timestamp));
+  }
+  if (sample_time) {
+    std::array<std::uint8_t, 4> d{};
+    bytes::put_be_u32(d.data(), *sample_time);
+    frames.push_back(CanFrame::make(kDefaultSampleTime, false, d, timestamp));
+  }
+  std::array<std::uint8_t, 8> d{};
+  const double c[4] = {q.w(), q.x(), q.y(), q.z()};
+  for (int k = 0; k < 4; ++k) {
+    const double r = std::round(c[k] * kScale);
+    bytes::put_be_u16(&d[2 * k], static_cast<std::uint16_t>(static_cast<std::int16_t>(r > kScale ? kScale : (r < -kScale ? -kScale : r))));
+  }
+  frames.push_back(CanFrame::make(kDefaultQuaternion, false, d, timestamp));
+  return frames;
+}
+
+}  // namespace posefair::drivers

@@ -1,0 +1,8 @@
+#pragma once
+#include <CLI/CLI.hpp>
+
+namespace posefair::tools {
+// `posefair spline`: minimal covariant-acceleration quaternion spline through keyframes
+// (Ramamoorthi & Barr; docs/quaternion-splines.md), sampled at a fixed rate.
+void add_spline_command(CLI::App& app, int& exit_code);
+}
