@@ -128,7 +128,8 @@ constexpr std::string_view kEngineKeys[] = {
     "window",   "lag",      "order",    "solver",    "iterations", "smoothing", "smoothing_r",
     "smoothing_t", "cutoff_hz", "rate_hz", "continuity", "lambda_r", "lambda_t", "variant",
     "epsilon_r", "epsilon_t", "bound",  "gap",       "unit_tolerance"};
-constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "overflow", "driver", "engine"};
+constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "overflow", "driver", "engine", "spline"};
+constexpr std::string_view kSplineKeys[] = {"publish_rate_hz", "bridge_gap", "order", "manifold", "velocity"};
 constexpr std::string_view kReplayKeys[] = {"type",   "path",   "timing",     "speed",        "schedule",     "loop",
                                             "rounds", "format", "joint",      "csv_prefix",   "skip_missing", "source_stream"};
 constexpr std::string_view kSyntheticKeys[] = {"type", "rate_hz", "duration", "rotation_noise", "with_position", "seed", "phase"};
@@ -784,7 +785,26 @@ class Parser {
     std::optional<EngineLayer> local;
     if (const toml::node* n = t.get("engine")) local = parse_engine(table_of(*n, key("engine"), "[stream.engine]"), key("engine"));
     s.engine = build_engine(global, local ? &*local : nullptr, driver_rate, t, prefix, s.name);
+    if (const toml::node* n = t.get("spline")) s.spline = parse_spline(table_of(*n, key("spline"), "[stream.spline]"), key("spline"));
     return s;
+  }
+
+  SplineConfig parse_spline(const toml::table& t, const std::string& prefix) const {
+    check_keys(t, prefix, kSplineKeys);
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    namespace gs = geometric_splines;
+    SplineConfig c;
+    if (const toml::node* n = t.get("publish_rate_hz")) c.publish_rate_hz = get_float(*n, key("publish_rate_hz"), FloatRange{0.0, true, 100000.0, false});
+    if (const toml::node* n = t.get("bridge_gap")) c.bridge_gap = get_float(*n, key("bridge_gap"), FloatRange{0.0, true, 10.0, false});
+    if (const toml::node* n = t.get("order")) c.spline.order = static_cast<int>(get_int(*n, key("order"), 1, gs::kMaxSplineOrder));
+    if (const toml::node* n = t.get("manifold"))
+      c.spline.manifold = get_choice<gs::OrientationManifold>(
+          *n, key("manifold"), {{"sphere", gs::OrientationManifold::Sphere}, {"lie-group", gs::OrientationManifold::LieGroup}});
+    if (const toml::node* n = t.get("velocity"))
+      // The fit looks several knots ahead: more delay, and the gap bridge holds only one sample.
+      c.spline.velocity.estimator = get_choice<gs::KnotVelocityEstimator>(
+          *n, key("velocity"), {{"bessel", gs::KnotVelocityEstimator::Bessel}, {"central", gs::KnotVelocityEstimator::CentralDifference}});
+    return c;
   }
 
   OutputConfig parse_output(const toml::node& node, const std::string& prefix, const std::vector<StreamConfig>& streams) const {

@@ -13,6 +13,8 @@
 #include <utility>
 
 #include "posefair/core/fairing_window.hpp"
+#include "posefair/core/fixed_rate_resampler.hpp"
+#include "posefair/core/gap_bridge.hpp"
 #include "posefair/daemon/driver_factory.hpp"
 #include "posefair/daemon/publisher.hpp"
 #include "posefair/daemon/ring_items.hpp"
@@ -54,6 +56,21 @@ struct Pipeline::Stream final : drivers::SampleSink {
         pose_ring(std::max<std::size_t>(c.ring_capacity, std::bit_ceil(static_cast<std::size_t>(2 * kPopBudget + c.engine.lag + 1))),
                   OverflowPolicy::DropOldest),
         outputs(static_cast<std::size_t>(window.max_outputs_per_push())) {
+    if (c.spline.bridging()) {
+      GapBridgeOptions o;
+      o.max_gap = c.spline.bridge_gap;
+      o.spline = c.spline.spline;
+      bridge.emplace(o);
+      bridged.resize(bridge->max_outputs());
+    }
+    if (c.spline.resampling()) {
+      FixedRateResamplerOptions o;
+      o.rate_hz = c.spline.publish_rate_hz;
+      o.max_step = c.engine.gate.gap_threshold;  // the window restarts after a longer step
+      o.spline = c.spline.spline;
+      resampler.emplace(o);
+      grid.resize(resampler->max_outputs());
+    }
     if (record) record_ring = std::make_unique<SpscRing<RingSample>>(owner.config_.recorder.ring_capacity, OverflowPolicy::DropNewest);
   }
 
@@ -78,6 +95,10 @@ struct Pipeline::Stream final : drivers::SampleSink {
   SpscRing<RingPose> pose_ring;                 // engine → publisher
   std::unique_ptr<SpscRing<RingSample>> record_ring;  // driver → recorder
   std::vector<FairedPose> outputs;              // engine scratch
+  std::optional<GapBridge> bridge;              // engine thread only; [stream.spline] bridge_gap
+  std::vector<Sample> bridged;                  // engine scratch
+  std::optional<FixedRateResampler> resampler;  // engine thread only; [stream.spline] publish_rate_hz
+  std::vector<FairedPose> grid;                 // engine scratch
   StreamCounters counters;
   std::atomic<bool> driver_running{false};
   std::atomic<bool> driver_done{false};
@@ -186,6 +207,48 @@ void Pipeline::stop(bool keep_recorder) {
   final_sequences_ = publisher_->next_sequences();
 }
 
+// Engine thread: a faired pose to the publisher as it is, or as the grid poses it completes
+// when the stream is resampled. True when anything was handed on.
+bool Pipeline::emit(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns) {
+  if (!s.resampler) {
+    s.pose_ring.push(pack(pose, s.index, enqueued_ns));
+    return true;
+  }
+  const std::size_t n = s.resampler->push(pose, s.grid);
+  for (std::size_t i = 0; i < n; ++i) s.pose_ring.push(pack(s.grid[i], s.index, enqueued_ns));
+  s.counters.resampled.fetch_add(n, std::memory_order_relaxed);
+  return n > 0;
+}
+
+// Engine thread: one sample into the window, its faired poses handed on.
+bool Pipeline::window_push(Stream& s, const Sample& sample, std::uint64_t enqueued_ns) {
+  bool any = false;
+  const int k = s.window.push(sample, s.outputs);
+  for (int j = 0; j < k; ++j) any = emit(s, s.outputs[static_cast<std::size_t>(j)], enqueued_ns) || any;
+  return any;
+}
+
+// Engine thread: one sample from the driver, through the gap bridge when there is one.
+bool Pipeline::fair(Stream& s, const Sample& sample, std::uint64_t enqueued_ns) {
+  if (!s.bridge) return window_push(s, sample, enqueued_ns);
+  bool any = false;
+  const std::size_t n = s.bridge->push(sample, s.bridged);
+  for (std::size_t i = 0; i < n; ++i) any = window_push(s, s.bridged[i], enqueued_ns) || any;
+  return any;
+}
+
+// Engine thread, after the stream's driver ended and its ring is empty: the sample the bridge
+// holds, then the window's lagged tail.
+void Pipeline::flush_stream(Stream& s) {
+  const std::uint64_t now = monotonic_ns();
+  if (s.bridge) {
+    const std::size_t n = s.bridge->flush(s.bridged);
+    for (std::size_t i = 0; i < n; ++i) window_push(s, s.bridged[i], now);
+  }
+  const int k = s.window.flush(s.outputs);
+  for (int j = 0; j < k; ++j) emit(s, s.outputs[static_cast<std::size_t>(j)], now);
+}
+
 void Pipeline::engine_loop() {
   ::pthread_setname_np(::pthread_self(), "pf-engine");  // for top -H, perf and gdb
   if (hooks_.on_realtime_thread_start) hooks_.on_realtime_thread_start();
@@ -200,18 +263,14 @@ void Pipeline::engine_loop() {
       for (int budget = kPopBudget; budget > 0 && s.ring.pop(r); --budget) {
         any = true;
         if (hooks_.before_engine_sample) hooks_.before_engine_sample(s.config.id);
-        const int k = s.window.push(unpack(r), s.outputs);
-        for (int j = 0; j < k; ++j) s.pose_ring.push(pack(s.outputs[static_cast<std::size_t>(j)], s.index, r.enqueued_ns));
-        emitted = emitted || k > 0;
+        emitted = fair(s, unpack(r), r.enqueued_ns) || emitted;
       }
       // Wake the publisher after each stream's batch (not after the whole pass), so it works
       // alongside the engine instead of after it.
       if (emitted) wake_publisher();
       // The driver has ended and everything it delivered is in: hand over the lagged tail.
       if (!s.flushed && s.driver_done.load(std::memory_order_acquire) && s.ring.size_approx() == 0) {
-        const int k = s.window.flush(s.outputs);
-        const std::uint64_t now = monotonic_ns();
-        for (int j = 0; j < k; ++j) s.pose_ring.push(pack(s.outputs[static_cast<std::size_t>(j)], s.index, now));
+        flush_stream(s);
         s.flushed = true;
         any = true;
       }
@@ -222,6 +281,10 @@ void Pipeline::engine_loop() {
       s.counters.emitted.store(w.emitted, std::memory_order_relaxed);
       s.counters.clamped.store(w.clamped, std::memory_order_relaxed);
       s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
+      if (s.bridge) {
+        s.counters.bridged_gaps.store(s.bridge->counters().gaps, std::memory_order_relaxed);
+        s.counters.bridged_samples.store(s.bridge->counters().samples, std::memory_order_relaxed);
+      }
     }
     if (any) {
       wake_publisher();
@@ -305,6 +368,11 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.record_dropped = s.record_ring ? s.record_ring->dropped() : 0;
     st.latency = s.counters.latency.snapshot();
     st.device = s.driver->health();
+    st.bridging = s.config.spline.bridging();
+    st.resampling = s.config.spline.resampling();
+    st.bridged_gaps = get(s.counters.bridged_gaps);
+    st.bridged_samples = get(s.counters.bridged_samples);
+    st.resampled = get(s.counters.resampled);
     out.push_back(std::move(st));
   }
   return out;

@@ -53,6 +53,14 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
                   us(s.latency.percentile(50)), us(s.latency.percentile(90)), us(s.latency.percentile(99)),
                   us(s.latency.max));
     lines.emplace_back(buf);
+    if (s.bridging) {
+      std::snprintf(buf, sizeof buf, ", bridged gaps %" PRIu64 " (samples %" PRIu64 ")", s.bridged_gaps, s.bridged_samples);
+      lines.back() += buf;
+    }
+    if (s.resampling) {
+      std::snprintf(buf, sizeof buf, ", resampled %" PRIu64, s.resampled);
+      lines.back() += buf;
+    }
     if (s.device) lines.back() += device_text(*s.device);
   }
   return lines;

@@ -40,6 +40,7 @@
 //     bad_checksum and the search resumes at its second byte (0xAA bytes in the data, e.g.
 //     index 0xAA, may look like a header; a good frame after them is still found).
 #include "posefair/drivers/bno08x_rvc_decoder.hpp"
+#include "frame_feed.hpp"
 
 #include <algorithm>
 #include <array>
@@ -73,33 +74,12 @@ class Bno08xRvcDecoder final : public Decoder {
 
   void feed(std::span<const std::uint8_t> in, DecodedSink& sink) override {
     counters_.bytes += in.size();
-    std::size_t off = 0;
-    if (carry_len_ > 0) {
-      // Decide the positions that start in the carried bytes, with enough input appended to
-      // complete any frame starting there.
-      std::array<std::uint8_t, 2 * kFrameSize> joined{};
-      const std::size_t head = std::min(in.size(), kFrameSize - 1);
-      std::memcpy(joined.data(), carry_.data(), carry_len_);
-      if (head > 0) std::memcpy(joined.data() + carry_len_, in.data(), head);
-      const std::size_t n = carry_len_ + head;
-      const std::size_t pos = scan(joined.data(), n, carry_len_, sink);
-      if (pos < carry_len_) {  // still short of a whole frame: all of `in` is in `joined`
-        carry_len_ = n - pos;
-        std::memmove(carry_.data(), joined.data() + pos, carry_len_);
-        return;
-      }
-      off = pos - carry_len_;
-      carry_len_ = 0;
-    }
-    const std::size_t rest = in.size() - off;
-    const std::size_t pos = scan(in.data() + off, rest, rest, sink);
-    carry_len_ = rest - pos;
-    if (carry_len_ > 0) std::memcpy(carry_.data(), in.data() + off + pos, carry_len_);
+    carry_.feed(in, [&](const std::uint8_t* p, std::size_t n, std::size_t limit) { return scan(p, n, limit, sink); });
   }
 
   void reset() override {
-    carry_len_ = 0;
-    in_resync_ = false;
+    carry_.reset();
+    end_resync();
     have_index_ = false;
     last_index_ = 0;
     counter_ = 0;
@@ -131,21 +111,13 @@ class Bno08xRvcDecoder final : public Decoder {
         ++pos;
         continue;
       }
-      in_resync_ = false;
+      end_resync();
       accept(f, sink);
       pos += kFrameSize;
     }
     return pos;
   }
 
-  void skip(std::size_t n) {
-    if (n == 0) return;
-    if (!in_resync_) {
-      in_resync_ = true;
-      ++counters_.resyncs;
-    }
-    counters_.skipped_bytes += n;
-  }
 
   void accept(const std::uint8_t* f, DecodedSink& sink) {
     ++counters_.frames;
@@ -175,9 +147,7 @@ class Bno08xRvcDecoder final : public Decoder {
     sink.on_sample(s);
   }
 
-  std::array<std::uint8_t, kFrameSize> carry_{};
-  std::size_t carry_len_ = 0;
-  bool in_resync_ = false;
+  detail::SplitFrameCarry<kFrameSize> carry_;
   bool have_index_ = false;
   std::uint8_t last_index_ = 0;
   std::uint64_t counter_ = 0;

@@ -40,6 +40,7 @@
 //   skipped_bytes, or held as the start of an incomplete frame. A run of skipped bytes between
 //   two valid frames is one resync (lines of debug text between sentences are resyncs).
 #include "posefair/drivers/posefair_serial_decoder.hpp"
+#include "frame_feed.hpp"
 
 #include <algorithm>
 #include <array>
@@ -92,34 +93,19 @@ class PosefairSerialDecoder final : public Decoder {
 
   void feed(std::span<const std::uint8_t> in, DecodedSink& sink) override {
     counters_.bytes += in.size();
-    while (!in.empty()) {
-      const std::size_t n = std::min(in.size(), buf_.size() - held_);
-      std::memcpy(buf_.data() + held_, in.data(), n);
-      held_ += n;
-      in = in.subspan(n);
-      const std::size_t used = process(sink);
-      std::memmove(buf_.data(), buf_.data() + used, held_ - used);
-      held_ -= used;
-    }
+    buffer_.feed(in, [&](const std::uint8_t* data, std::size_t held) { return process(data, held, sink); });
   }
 
   void reset() override {
-    held_ = 0;
-    skipping_ = false;
+    buffer_.reset();
+    end_resync();
     have_time_ = false;
   }
 
  private:
-  void skip(std::size_t n) {
-    if (n == 0) return;
-    counters_.skipped_bytes += n;
-    if (!skipping_) ++counters_.resyncs;
-    skipping_ = true;
-  }
-
   void accept_frame() {
     ++counters_.frames;
-    skipping_ = false;
+    end_resync();
   }
 
   double unwrap_time(std::uint32_t raw) {
@@ -129,11 +115,11 @@ class PosefairSerialDecoder final : public Decoder {
     return static_cast<double>(time_us_) * kMicro;
   }
 
-  std::size_t process(DecodedSink& sink) {
+  std::size_t process(const std::uint8_t* data, std::size_t held, DecodedSink& sink) {
     std::size_t i = 0;
-    while (i < held_) {
-      const std::uint8_t* p = buf_.data() + i;
-      const std::size_t avail = held_ - i;
+    while (i < held) {
+      const std::uint8_t* p = data + i;
+      const std::size_t avail = held - i;
       if (p[0] == '$') {
         const std::size_t limit = std::min(avail, kMaxSentence);
         std::size_t j = 1;
@@ -304,9 +290,7 @@ class PosefairSerialDecoder final : public Decoder {
     sink.on_sample(sample);
   }
 
-  std::array<std::uint8_t, kBufferSize> buf_{};
-  std::size_t held_ = 0;
-  bool skipping_ = false;
+  detail::MessageBuffer<kBufferSize> buffer_;
   bool have_time_ = false;
   std::uint32_t last_time_ = 0;
   std::uint64_t time_us_ = 0;

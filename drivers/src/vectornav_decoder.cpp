@@ -190,19 +190,12 @@ class VectorNavDecoder final : public Decoder {
   void reset() override {
     skip(len_);
     len_ = 0;
-    skipping_ = false;
+    end_resync();
   }
 
  private:
-  void skip(std::size_t n) {
-    if (n == 0) return;
-    if (!skipping_) ++counters_.resyncs;
-    skipping_ = true;
-    counters_.skipped_bytes += n;
-  }
-
   void start_sentence() {
-    skipping_ = false;
+    end_resync();
     buf_[0] = '$';
     len_ = 1;
   }
@@ -299,7 +292,6 @@ class VectorNavDecoder final : public Decoder {
 
   std::array<char, kVectorNavMaxSentence> buf_{};
   std::size_t len_ = 0;  // 0 while hunting for '$'
-  bool skipping_ = false;
   bool accept_unchecked_;
 };
 

@@ -52,6 +52,7 @@
 //     checksum fails counts in bad_checksum, and the search resumes at its second byte (so a
 //     good frame starting inside it is still found).
 #include "posefair/drivers/witmotion_decoder.hpp"
+#include "frame_feed.hpp"
 
 #include <algorithm>
 #include <array>
@@ -99,33 +100,12 @@ class WitMotionDecoder final : public Decoder {
 
   void feed(std::span<const std::uint8_t> in, DecodedSink& sink) override {
     counters_.bytes += in.size();
-    std::size_t off = 0;
-    if (carry_len_ > 0) {
-      // Decide the positions that start in the carried bytes, with enough input appended to
-      // complete any frame starting there.
-      std::array<std::uint8_t, 2 * kFrameSize> joined{};
-      const std::size_t head = std::min(in.size(), kFrameSize - 1);
-      std::memcpy(joined.data(), carry_.data(), carry_len_);
-      if (head > 0) std::memcpy(joined.data() + carry_len_, in.data(), head);
-      const std::size_t n = carry_len_ + head;
-      const std::size_t pos = scan(joined.data(), n, carry_len_, sink);
-      if (pos < carry_len_) {  // still short of a whole frame: all of `in` is in `joined`
-        carry_len_ = n - pos;
-        std::memmove(carry_.data(), joined.data() + pos, carry_len_);
-        return;
-      }
-      off = pos - carry_len_;
-      carry_len_ = 0;
-    }
-    const std::size_t rest = in.size() - off;
-    const std::size_t pos = scan(in.data() + off, rest, rest, sink);
-    carry_len_ = rest - pos;
-    if (carry_len_ > 0) std::memcpy(carry_.data(), in.data() + off + pos, carry_len_);
+    carry_.feed(in, [&](const std::uint8_t* p, std::size_t n, std::size_t limit) { return scan(p, n, limit, sink); });
   }
 
   void reset() override {
-    carry_len_ = 0;
-    in_resync_ = false;
+    carry_.reset();
+    end_resync();
     quaternion_seen_ = false;
     angles_since_quaternion_ = 0;
     time_valid_ = false;
@@ -161,21 +141,13 @@ class WitMotionDecoder final : public Decoder {
         ++pos;
         continue;
       }
-      in_resync_ = false;
+      end_resync();
       accept(f, sink);
       pos += kFrameSize;
     }
     return pos;
   }
 
-  void skip(std::size_t n) {
-    if (n == 0) return;
-    if (!in_resync_) {
-      in_resync_ = true;
-      ++counters_.resyncs;
-    }
-    counters_.skipped_bytes += n;
-  }
 
   void accept(const std::uint8_t* f, DecodedSink& sink) {
     ++counters_.frames;
@@ -263,9 +235,7 @@ class WitMotionDecoder final : public Decoder {
   }
 
   const bool scalar_first_;
-  std::array<std::uint8_t, kFrameSize> carry_{};
-  std::size_t carry_len_ = 0;
-  bool in_resync_ = false;
+  detail::SplitFrameCarry<kFrameSize> carry_;
   bool quaternion_seen_ = false;
   int angles_since_quaternion_ = 0;
   bool time_valid_ = false;

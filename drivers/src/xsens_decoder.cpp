@@ -60,6 +60,7 @@
 // - Position outputs (LatLon, PositionEcef) are geodetic, not metres in a local frame: not read.
 // - The MTi 1-series' I2C/SPI transport (MTSSP) frames differently and is not handled here.
 #include "posefair/drivers/xsens_decoder.hpp"
+#include "frame_feed.hpp"
 
 #include <algorithm>
 #include <array>
@@ -117,39 +118,24 @@ class XsensDecoder final : public Decoder {
 
   void feed(std::span<const std::uint8_t> in, DecodedSink& sink) override {
     counters_.bytes += in.size();
-    while (!in.empty()) {
-      const std::size_t n = std::min(in.size(), buf_.size() - held_);
-      std::memcpy(buf_.data() + held_, in.data(), n);
-      held_ += n;
-      in = in.subspan(n);
-      const std::size_t used = process(sink);
-      std::memmove(buf_.data(), buf_.data() + used, held_ - used);
-      held_ -= used;
-    }
+    buffer_.feed(in, [&](const std::uint8_t* data, std::size_t held) { return process(data, held, sink); });
   }
 
   void reset() override {
-    held_ = 0;
-    skipping_ = false;
+    buffer_.reset();
+    end_resync();
     counter_.reset();
     time_.reset();
   }
 
  private:
-  void skip(std::size_t n) {
-    if (n == 0) return;
-    counters_.skipped_bytes += n;
-    if (!skipping_) ++counters_.resyncs;
-    skipping_ = true;
-  }
-
-  // Handles every whole message in buf_[0, held_); returns how many bytes it used (the rest
+  // Handles every whole message in data[0, held); returns how many bytes it used (the rest
   // is the start of an incomplete message, shorter than kMaxMessage).
-  std::size_t process(DecodedSink& sink) {
+  std::size_t process(const std::uint8_t* data, std::size_t held, DecodedSink& sink) {
     std::size_t i = 0;
-    while (i < held_) {
-      const std::uint8_t* p = buf_.data() + i;
-      const std::size_t avail = held_ - i;
+    while (i < held) {
+      const std::uint8_t* p = data + i;
+      const std::size_t avail = held - i;
       if (p[0] != kPreamble) {
         const void* next = std::memchr(p, kPreamble, avail);
         const std::size_t k = next ? static_cast<std::size_t>(static_cast<const std::uint8_t*>(next) - p) : avail;
@@ -186,7 +172,7 @@ class XsensDecoder final : public Decoder {
         continue;
       }
       ++counters_.frames;
-      skipping_ = false;
+      end_resync();
       if (p[2] == kMtData2)
         handle_mtdata2({p + header, data_len}, sink);
       else
@@ -281,9 +267,7 @@ class XsensDecoder final : public Decoder {
     sink.on_sample(s);
   }
 
-  std::array<std::uint8_t, kBufferSize> buf_{};
-  std::size_t held_ = 0;
-  bool skipping_ = false;
+  detail::MessageBuffer<kBufferSize> buffer_;
   Unwrapper counter_{16};
   Unwrapper time_{32};
 };

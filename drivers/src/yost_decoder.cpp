@@ -164,7 +164,7 @@ class YostDecoder final : public Decoder {
   void reset() override {
     skip(pending_);
     pending_ = 0;
-    skipping_ = false;
+    end_resync();
     have_timestamp_ = false;
     epoch_ = 0;
   }
@@ -177,7 +177,7 @@ class YostDecoder final : public Decoder {
     std::size_t o = from;
     while (o < limit && total - o >= packet_size_) {
       if (try_packet(data + o, sink)) {
-        skipping_ = false;
+        end_resync();
         o += packet_size_;
         continue;
       }
@@ -233,19 +233,12 @@ class YostDecoder final : public Decoder {
     return epoch_ + raw;
   }
 
-  void skip(std::size_t n) {
-    if (n == 0) return;
-    if (!skipping_) ++counters_.resyncs;
-    skipping_ = true;
-    counters_.skipped_bytes += n;
-  }
 
   const Layout l_;
   const std::size_t data_length_;
   const std::size_t packet_size_;
   std::array<std::uint8_t, 2 * kMaxPacket> work_{};  // [0, pending_): bytes kept from the last feed
   std::size_t pending_ = 0;
-  bool skipping_ = false;
   bool have_timestamp_ = false;
   std::uint32_t last_raw_ = 0;
   std::uint64_t epoch_ = 0;

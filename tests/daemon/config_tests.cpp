@@ -412,6 +412,38 @@ driver = { type = "serial", device = "/dev/ttyUSB1", protocol = "yost", yost_hea
   EXPECT_EQ(c.streams[1].driver.serial.decoder.yost_data_length, "16");
 }
 
+TEST(Config, TheSplineTableSetsBridgingAndResampling) {
+  const DaemonConfig c = parse_config(R"toml(
+[[stream]]
+id = 1
+name = "plain"
+driver = { type = "synthetic" }
+
+[[stream]]
+id = 2
+name = "display"
+driver = { type = "synthetic" }
+[stream.spline]
+publish_rate_hz = 90.0
+bridge_gap = 0.15
+order = 3
+manifold = "lie-group"
+velocity = "central"
+)toml",
+                                      "spline.toml");
+  ASSERT_EQ(c.streams.size(), 2u);
+  EXPECT_FALSE(c.streams[0].spline.resampling());
+  EXPECT_FALSE(c.streams[0].spline.bridging());
+  const SplineConfig& s = c.streams[1].spline;
+  EXPECT_TRUE(s.resampling());
+  EXPECT_TRUE(s.bridging());
+  EXPECT_EQ(s.publish_rate_hz, 90.0);
+  EXPECT_EQ(s.bridge_gap, 0.15);
+  EXPECT_EQ(s.spline.order, 3);
+  EXPECT_EQ(s.spline.manifold, geometric_splines::OrientationManifold::LieGroup);
+  EXPECT_EQ(s.spline.velocity.estimator, geometric_splines::KnotVelocityEstimator::CentralDifference);
+}
+
 TEST(Config, TheMostSpecificTableDecidesTheSmoothing) {
   testing::ScratchDir dir("posefair-config-");
   write_file(dir / "poses.csv", "t,qw,qx,qy,qz\n0,1,0,0,0\n");
@@ -951,6 +983,34 @@ id = 1
 name = "a"
 driver = { type = "serial", device = "/dev/ttyUSB0", time_source = "devise", protocol = "witmotion" }
 )", "stream[1].driver.time_source: expected one of 'auto', 'receive', 'device', got 'devise' (did you mean 'device'?)", 4},
+    {"spline: a rate of zero", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.spline]
+publish_rate_hz = 0.0
+)", "stream[1].spline.publish_rate_hz: ", 6},
+    {"spline: the fit estimate is not offered live", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.spline]
+bridge_gap = 0.1
+velocity = "fit"
+)", "stream[1].spline.velocity: expected one of 'bessel', 'central', got 'fit'", 7},
+    {"spline: order out of range", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+spline = { order = 9 }
+)", "stream[1].spline.order: ", 5},
+    {"spline: unknown key", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.spline]
+rate_hz = 90.0
+)", "stream[1].spline.rate_hz: unknown key", 6},
     {"a table that is not one", R"(daemon = 5
 [[stream]]
 id = 1

@@ -37,6 +37,8 @@
 #include <vector>
 
 #include "../protocol/subprocess.hpp"
+#include "../replay/replay_log.hpp"
+#include "../support/pseudo_terminal.hpp"
 #include "../support/test_files.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
@@ -881,6 +883,139 @@ TEST(DaemonSystemd, NotifiesReadyStatusWatchdogAndStoppingAndLogsCountersOnSigus
   const std::vector<std::string> last = notify.drain(200ms);
   EXPECT_TRUE(std::any_of(last.begin(), last.end(), [](const std::string& m) { return m.find("STOPPING=1") != std::string::npos; }))
       << "no STOPPING=1 at SIGTERM";
+}
+
+}  // namespace
+}  // namespace posefair::testing
+
+// ---------------------------------------------------------------------------------------------
+// 9. A serial device: a golden replay log (tests/replay/) written into a pseudo-terminal that
+//    the daemon's serial stream opens through a symlink, at the device's pace; the device's
+//    link appears in the counter line and in STATUS=, and an unplug is counted and reported.
+
+namespace posefair::testing {
+namespace {
+
+TEST(DaemonSerial, AGoldenLogThroughAPtyIsFairedAndTheLinkIsReported) {
+  ScratchDir dir("posefair-e2e-");
+  Collector poses;
+  const replay::ReplayLog log = replay::read_replay_log(fs::path(POSEFAIR_SOURCE_DIR) / "tests/replay/posefair-text.log");
+  auto pty = std::make_unique<PseudoTerminal>();
+  const fs::path link = dir / "ttyPF";
+  fs::create_symlink(pty->slave(), link);
+  const fs::path config = dir / "posefaird.toml";
+  write_text(config, "[logging]\nstatus_interval = 0\n\n[[stream]]\nid = 1\nname = \"imu\"\n"
+                     "driver = { type = \"serial\", device = \"" + link.string() +
+                     "\", protocol = \"posefair\", reconnect_min = 0.05, reconnect_max = 0.2 }\n\n"
+                     "[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(poses.port()) + "\"]\n");
+  NotifySocket notify(dir / "notify.sock");
+  ::setenv("NOTIFY_SOCKET", (dir / "notify.sock").c_str(), 1);
+  Subprocess d(daemon_args(config), dir / "d.out", dir / "d.err");
+  ::unsetenv("NOTIFY_SOCKET");
+  ASSERT_TRUE(wait_for_log_or_exit(d, "opened ", 10s)) << d.err();
+
+  // 300 frames at about 95 Hz, as the device would send them.
+  const std::size_t chunk = log.data.size() / 300 + 1;
+  for (std::size_t at = 0; at < log.data.size(); at += chunk) {
+    pty->write(std::string_view(log.data).substr(at, chunk));
+    std::this_thread::sleep_for(10ms);
+  }
+  // The .chk says 288 samples survive the log's faults; all but the lag's tail are faired.
+  ASSERT_TRUE(wait_until([&] { return poses.count(1) >= 280 || !d.running(); }, 10s)) << d.err();
+  d.send_signal(SIGUSR1);
+  ASSERT_TRUE(wait_for_log_or_exit(d, "; device connected, outages 0, reconnects 0", 5s)) << d.err();
+  EXPECT_NE(d.err().find("stream imu (id 1, serial:" + link.string() + " (posefair)): received 288 ("), std::string::npos)
+      << d.err();
+  EXPECT_NE(d.err().find(", frames 288, bad 9, resyncs 14 (skipped 3871 bytes)"), std::string::npos) << d.err();
+
+  // Unplug: the stream stays, the outage is logged once and shown in STATUS= and the counters.
+  pty.reset();
+  ASSERT_TRUE(wait_for_log_or_exit(d, "stream 'imu': lost the device", 5s)) << d.err();
+  const std::vector<std::string> messages = notify.drain(2500ms);
+  EXPECT_TRUE(std::any_of(messages.begin(), messages.end(), [](const std::string& m) {
+    return m.rfind("STATUS=imu ", 0) == 0 && m.find(" DISCONNECTED outages 1 bad 9") != std::string::npos;
+  })) << "no STATUS= with the outage; got " << messages.size() << " messages";
+  d.send_signal(SIGUSR1);
+  ASSERT_TRUE(wait_for_log_or_exit(d, "; device DISCONNECTED, outages 1, reconnects 0", 5s)) << d.err();
+  EXPECT_TRUE(d.running());
+  d.send_signal(SIGTERM);
+  EXPECT_EQ(d.wait(15s), 0) << d.err();
+}
+
+}  // namespace
+}  // namespace posefair::testing
+
+// ---------------------------------------------------------------------------------------------
+// 10. [stream.spline]: a replayed recording with a short and a long gap, published at 250 Hz.
+//     The short gap is bridged on the spline (the window does not restart, the poses across it
+//     are flagged bridged); the long one restarts the window and the grid (no pose inside it);
+//     every pose lies on the 250 Hz grid.
+
+namespace posefair::testing {
+namespace {
+
+TEST(DaemonSpline, AReplayWithGapsIsBridgedAndPublishedOnA250HzGrid) {
+  ScratchDir dir("posefair-e2e-");
+  Collector poses;
+  // The demo excerpt (285.7 Hz) without rows 500..519 (70 ms) and 1200..1299 (350 ms).
+  const std::vector<std::string> rows = lines_of(slurp(kDemoCsv));
+  std::string csv = rows[0] + "\n";
+  std::vector<double> kept_times;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const std::size_t r = i - 1;
+    if ((r >= 500 && r < 520) || (r >= 1200 && r < 1300)) continue;
+    csv += rows[i] + "\n";
+    kept_times.push_back(std::stod(rows[i]));
+  }
+  const double short_from = std::stod(rows[500]), short_to = std::stod(rows[521]);  // rows 499 and 520
+  const double long_from = std::stod(rows[1200]), long_to = std::stod(rows[1301]);   // rows 1199 and 1300
+  write_text(dir / "gaps.csv", csv);
+  const fs::path config = dir / "posefaird.toml";
+  write_text(config, "[daemon]\nexit_when_sources_end = true\n[logging]\nstatus_interval = 0\n\n"
+                     "[[stream]]\nid = 1\nname = \"gaps\"\n"
+                     "driver = { type = \"replay\", path = \"gaps.csv\", timing = \"original\", speed = 5.0 }\n"
+                     "[stream.spline]\npublish_rate_hz = 250.0\nbridge_gap = 0.1\n\n"
+                     "[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(poses.port()) + "\"]\n");
+  Subprocess d(daemon_args(config), dir / "d.out", dir / "d.err");
+  ASSERT_EQ(d.wait(60s), 0) << d.err();
+  std::this_thread::sleep_for(200ms);  // the last datagrams in flight
+  const auto all = poses.all();
+  ASSERT_GT(all.size(), 1500u) << d.err();
+
+  std::size_t bridged = 0, jumps = 0;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const daemon::PoseMessage& m = all[i].m;
+    const double t = m.sample_time;
+    ASSERT_NEAR(t * 250.0, std::round(t * 250.0), 1e-6) << "pose " << i << " off the 250 Hz grid: " << t;
+    EXPECT_FALSE(t > long_from + 1e-9 && t < long_to - 1e-9) << "pose " << i << " inside the long gap: " << t;
+    if (m.bridged()) {
+      ++bridged;
+      EXPECT_GT(t, short_from - 0.004) << "a bridged pose away from the short gap";
+      EXPECT_LT(t, short_to + 0.004) << "a bridged pose away from the short gap";
+    }
+    if (i > 0) {
+      const double step = t - all[i - 1].m.sample_time;
+      if (std::abs(step - 0.004) > 1e-9) {
+        ++jumps;
+        EXPECT_GT(step, 0.3) << "pose " << i << ": only the long gap breaks the grid";
+      }
+    }
+  }
+  EXPECT_EQ(jumps, 1u);
+  // The 70 ms gap is 17 or 18 grid steps, all from bridged samples or their neighbours.
+  EXPECT_GE(bridged, 17u);
+  EXPECT_LE(bridged, 20u);
+  // The grid covers the recording up to its end, less the resampler's delay.
+  EXPECT_LT(all.front().m.sample_time - kept_times.front(), 0.02);
+  EXPECT_LT(kept_times.back() - all.back().m.sample_time, 0.02);
+
+  const auto counters = last_counters(d.err(), "gaps", 1);
+  ASSERT_TRUE(counters) << d.err();
+  EXPECT_EQ(counters->received, 2000u - 120u);
+  EXPECT_EQ(counters->published, all.size()) << counters->line;
+  EXPECT_NE(counters->line.find(", bridged gaps 1 (samples 20), resampled " + std::to_string(all.size())), std::string::npos)
+      << counters->line;
+  EXPECT_NE(counters->line.find(", restarts 1,"), std::string::npos) << "only the long gap restarts the window: " << counters->line;
 }
 
 }  // namespace

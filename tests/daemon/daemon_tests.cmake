@@ -12,10 +12,11 @@ posefair_add_test(pipeline_tests
 # loopback interface, every wait bounded and every child killed at the end: `posefair fair
 # --causal` against the daemon bit for bit, SIGHUP reloads (good and bad), SIGTERM while
 # recording and the replay of that recording, a truncated recording, malformed configs, and
-# `posefair sub --idle`.
+# `posefair sub --idle`, a serial device on a pseudo-terminal (a golden replay log, then an
+# unplug).
 posefair_add_test(daemon_e2e_tests
   SOURCES daemon_e2e_tests.cpp
-  LIBS posefair::protocol posefair::drivers
+  LIBS posefair::protocol posefair::drivers posefair_replay_log
   LABELS "daemon;network;e2e;threads")
 add_dependencies(daemon_e2e_tests posefaird posefair)
 

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <sstream>
 #include <string>
@@ -27,6 +28,7 @@
 #include "posefair/daemon/udp_socket.hpp"
 
 #include "../support/counting_allocator.hpp"
+#include "../support/test_files.hpp"
 #include "udp_collector.hpp"
 
 namespace posefair::daemon {
@@ -165,6 +167,34 @@ TEST_F(PipelineAllocation, GaussNewtonOnASyntheticStreamAllocatesNothingOnTheRea
   EXPECT_EQ(run.stats.published, run.stats.received);
   EXPECT_EQ(run.stats.send_failures, 0u);
   EXPECT_GT(run.datagrams, 0u);
+}
+
+// Gap bridging and resampling run on the engine thread too: the demo recording with three
+// 20-sample dropouts, bridged and published at 1 kHz, allocates nothing.
+TEST_F(PipelineAllocation, BridgingAndResamplingAllocateNothingOnTheRealtimeThreads) {
+  testing::ScratchDir dir("posefair-alloc-");
+  const std::string text = testing::slurp(kDemoCsv);
+  std::istringstream in(text);
+  std::string line, csv;
+  for (std::size_t row = 0; std::getline(in, line); ++row)
+    if (row == 0 || (row - 1) % 500 < 480) csv += line + "\n";  // rows 480..499 of every 500 lost
+  std::ofstream(dir / "gaps.csv") << csv;
+  const PipelineRun run = run_pipeline("type = \"replay\"\npath = \"" + (dir / "gaps.csv").string() +
+                                           "\"\ntiming = \"fast\"\n"
+                                           "[stream.spline]\npublish_rate_hz = 1000.0\nbridge_gap = 0.1\n",
+                                       "linear", "binary");
+  std::printf("%s\n", describe(run).c_str());
+  SCOPED_TRACE(describe(run));
+  EXPECT_TRUE(run.ended) << "the replay did not end";
+  ASSERT_EQ(run.threads, 2) << "the engine and the publisher thread each claim a slot";
+  for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
+  EXPECT_EQ(run.stats.received, kDemoSamples - 80);
+  EXPECT_EQ(run.stats.bridged_gaps, 3u) << "the fourth dropout is the recording's end";
+  EXPECT_TRUE(run.stats.resampling);
+  EXPECT_GT(run.stats.resampled, 6900u);  // 7 s at 1 kHz, less the spline's delay at both ends
+  // As fast as possible, 3.5 grid poses per sample outrun the publisher: the oldest are dropped,
+  // and counted.
+  EXPECT_EQ(run.stats.published + run.stats.publish_dropped, run.stats.resampled);
 }
 
 // The negative control: JSON lines allocate a string per pose on the publisher thread, so the

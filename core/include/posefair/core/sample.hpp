@@ -11,6 +11,7 @@ enum SampleFlags : std::uint32_t {
   kHasPosition = 1u << 0,
   kHasDeviceTime = 1u << 1,
   kClamped = 1u << 2,  // FairedPose only: the ε projection moved this pose (it sits on its bound)
+  kBridged = 1u << 3,  // made on a spline across a gap in the input (gap_bridge.hpp), not measured
 };
 
 struct Sample {

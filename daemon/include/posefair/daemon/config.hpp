@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "posefair/core/fairing_window.hpp"
+#include "posefair/core/pose_spline.hpp"
 #include "posefair/daemon/overflow_policy.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
@@ -107,6 +108,16 @@ struct DriverConfig {
   SerialSourceConfig serial;        // type == Serial
 };
 
+// [stream.spline]: the geometric spline around the fairing window (docs/splines.md, "In the
+// daemon"). Both parts are off unless their key is given.
+struct SplineConfig {
+  double publish_rate_hz = 0.0;  // > 0: publish on a fixed grid at this rate instead of every faired pose
+  double bridge_gap = 0.0;       // s, > 0: fill input gaps up to this long on the spline
+  geometric_splines::PoseSplineOptions spline;  // order, manifold, knot velocity estimate
+  bool resampling() const { return publish_rate_hz > 0.0; }
+  bool bridging() const { return bridge_gap > 0.0; }
+};
+
 struct StreamConfig {
   std::uint32_t id = 0;           // unique; the wire protocol's stream id
   std::string name;               // unique, non-empty; for logs, STATUS= and the recording's stream table
@@ -117,6 +128,7 @@ struct StreamConfig {
   // validated (posefair::validate) and in the engine's units (epsilon_r as dist on S³, i.e.
   // half the rotation angle given in the file; smoothing from cutoff_hz when that was given).
   WindowConfig engine;
+  SplineConfig spline;
 };
 
 struct OutputConfig {

@@ -81,6 +81,10 @@ class Pipeline {
  private:
   struct Stream;
   void engine_loop();
+  bool emit(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns);
+  bool window_push(Stream& s, const Sample& sample, std::uint64_t enqueued_ns);
+  bool fair(Stream& s, const Sample& sample, std::uint64_t enqueued_ns);
+  void flush_stream(Stream& s);
   void publisher_loop();
   void recorder_loop();
   void wake_engine();

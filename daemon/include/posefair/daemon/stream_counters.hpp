@@ -20,6 +20,9 @@ struct StreamCounters {
   std::atomic<std::uint64_t> emitted{0};          // poses the engine produced
   std::atomic<std::uint64_t> clamped{0};          // of which the ε projection moved
   std::atomic<std::uint64_t> restarts{0};         // windows restarted after a gap
+  std::atomic<std::uint64_t> bridged_gaps{0};     // input gaps filled on the spline ([stream.spline] bridge_gap)
+  std::atomic<std::uint64_t> bridged_samples{0};  // samples made for them
+  std::atomic<std::uint64_t> resampled{0};        // grid poses made ([stream.spline] publish_rate_hz)
   std::atomic<std::uint64_t> published{0};        // poses sent to at least one destination (or to none configured)
   std::atomic<std::uint64_t> send_failures{0};    // failed sends (one per destination)
   std::atomic<std::uint64_t> recorded{0};         // handed to the recorder's writer
@@ -35,6 +38,8 @@ struct StreamStats {
   std::uint64_t received = 0, ring_dropped = 0, rejected = 0, out_of_order = 0, emitted = 0, clamped = 0, restarts = 0;
   std::uint64_t publish_dropped = 0, published = 0, send_failures = 0, recorded = 0, record_dropped = 0;
   HistogramSnapshot latency;
+  bool bridging = false, resampling = false;  // [stream.spline] parts configured
+  std::uint64_t bridged_gaps = 0, bridged_samples = 0, resampled = 0;
   std::optional<drivers::DeviceHealth> device;  // the device link, for drivers that have one
   // Poses lost on the way to subscribers: overflow of the engine's and the publisher's rings.
   std::uint64_t dropped() const { return ring_dropped + publish_dropped; }

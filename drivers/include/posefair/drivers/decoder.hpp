@@ -78,7 +78,20 @@ class Decoder {
   const DecoderCounters& counters() const { return counters_; }
 
  protected:
+  // Resynchronisation accounting, the same for every protocol: n bytes skipped while looking
+  // for a frame start. A run of skips until the next valid frame (end_resync) is one resync.
+  void skip(std::size_t n) {
+    if (n == 0) return;
+    if (!resyncing_) ++counters_.resyncs;
+    resyncing_ = true;
+    counters_.skipped_bytes += n;
+  }
+  void end_resync() { resyncing_ = false; }
+
   DecoderCounters counters_;
+
+ private:
+  bool resyncing_ = false;
 };
 
 // The registry: nullptr for an unknown protocol name. Throws std::invalid_argument for an
