@@ -7,12 +7,6 @@
 namespace posefair::geometric_splines {
 namespace {
 
-double binomial(int n, int r) {
-  double b = 1.0;
-  for (int i = 1; i <= r; ++i) b = b * (n - r + i) / i;
-  return b;
-}
-
 // q-th u-derivative of the Taylor component sum_j d[j] h^j (u - u0)^j / j!.
 template <int N>
 Vector<N> taylor_component(std::span<const Vector<N>> d, double h, double x, int q) {

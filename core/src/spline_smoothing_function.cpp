@@ -5,15 +5,11 @@
 #include <string>
 
 namespace posefair::geometric_splines {
-namespace {
-
 double binomial(int n, int r) {
   double b = 1.0;
   for (int i = 1; i <= r; ++i) b = b * (n - r + i) / i;
   return b;
 }
-
-}  // namespace
 
 double polynomial_derivative(const double* c, int n, double u, int j) {
   // Horner over the j-times differentiated coefficients c[m] * m! / (m - j)!.

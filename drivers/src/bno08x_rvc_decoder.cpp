@@ -40,7 +40,6 @@
 //     bad_checksum and the search resumes at its second byte (0xAA bytes in the data, e.g.
 //     index 0xAA, may look like a header; a good frame after them is still found).
 #include "posefair/drivers/bno08x_rvc_decoder.hpp"
-#include "frame_feed.hpp"
 
 #include <algorithm>
 #include <array>
@@ -50,6 +49,7 @@
 #include "posefair/drivers/byte_order.hpp"
 #include "posefair/drivers/checksums.hpp"
 #include "posefair/drivers/euler_angles.hpp"
+#include "frame_feed.hpp"
 
 namespace posefair::drivers {
 namespace {

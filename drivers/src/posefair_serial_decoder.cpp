@@ -40,7 +40,6 @@
 //   skipped_bytes, or held as the start of an incomplete frame. A run of skipped bytes between
 //   two valid frames is one resync (lines of debug text between sentences are resyncs).
 #include "posefair/drivers/posefair_serial_decoder.hpp"
-#include "frame_feed.hpp"
 
 #include <algorithm>
 #include <array>
@@ -51,6 +50,7 @@
 
 #include "posefair/drivers/byte_order.hpp"
 #include "posefair/drivers/checksums.hpp"
+#include "frame_feed.hpp"
 
 namespace posefair::drivers {
 namespace {

@@ -52,7 +52,6 @@
 //     checksum fails counts in bad_checksum, and the search resumes at its second byte (so a
 //     good frame starting inside it is still found).
 #include "posefair/drivers/witmotion_decoder.hpp"
-#include "frame_feed.hpp"
 
 #include <algorithm>
 #include <array>
@@ -64,6 +63,7 @@
 #include "posefair/drivers/byte_order.hpp"
 #include "posefair/drivers/checksums.hpp"
 #include "posefair/drivers/euler_angles.hpp"
+#include "frame_feed.hpp"
 
 namespace posefair::drivers {
 namespace {

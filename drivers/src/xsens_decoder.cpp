@@ -60,7 +60,6 @@
 // - Position outputs (LatLon, PositionEcef) are geodetic, not metres in a local frame: not read.
 // - The MTi 1-series' I2C/SPI transport (MTSSP) frames differently and is not handled here.
 #include "posefair/drivers/xsens_decoder.hpp"
-#include "frame_feed.hpp"
 
 #include <algorithm>
 #include <array>
@@ -71,6 +70,8 @@
 
 #include "posefair/drivers/byte_order.hpp"
 #include "posefair/drivers/checksums.hpp"
+#include "posefair/drivers/counter_unwrap.hpp"
+#include "frame_feed.hpp"
 
 namespace posefair::drivers {
 namespace {
@@ -92,25 +93,6 @@ constexpr double kUnitTolerance = 1e-3;
 std::uint64_t be_u64(const std::uint8_t* p) {
   return static_cast<std::uint64_t>(bytes::be_u32(p)) << 32 | bytes::be_u32(p + 4);
 }
-
-// Forward-only unwrapping of a counter that wraps at 2^bits.
-class Unwrapper {
- public:
-  explicit Unwrapper(unsigned bits) : mask_((std::uint64_t{1} << bits) - 1) {}
-  std::uint64_t update(std::uint64_t raw) {
-    total_ = have_ ? total_ + ((raw - last_) & mask_) : raw;
-    have_ = true;
-    last_ = raw;
-    return total_;
-  }
-  void reset() { have_ = false; }
-
- private:
-  std::uint64_t mask_;
-  std::uint64_t last_ = 0;
-  std::uint64_t total_ = 0;
-  bool have_ = false;
-};
 
 class XsensDecoder final : public Decoder {
  public:
@@ -268,8 +250,8 @@ class XsensDecoder final : public Decoder {
   }
 
   detail::MessageBuffer<kBufferSize> buffer_;
-  Unwrapper counter_{16};
-  Unwrapper time_{32};
+  CounterUnwrapper counter_{16};
+  CounterUnwrapper time_{32};
 };
 
 }  // namespace

@@ -14,6 +14,9 @@ namespace posefair::geometric_splines {
 // Highest supported smoothness order k (phi has degree 2k-1, the weights 4k-2).
 inline constexpr int kMaxSplineOrder = 8;
 
+// The binomial coefficient C(n, r) as a double (small n: phi's and Leibniz's coefficients).
+double binomial(int n, int r);
+
 class SmoothingFunction {
  public:
   // k >= 1 and <= kMaxSplineOrder; throws std::invalid_argument otherwise.

@@ -1,7 +1,7 @@
 #pragma once
 // Forward-only unwrapping of a counter that wraps at 2^bits (a packet counter, a device clock):
 // each step is taken modulo the counter's range, so the unwrapped value never decreases; a
-// device restart looks like a rollover. Shared by the CAN decoders.
+// device restart looks like a rollover. Shared by the Xsens and CAN decoders.
 #include <cstdint>
 
 namespace posefair::drivers {
