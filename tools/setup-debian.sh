@@ -21,6 +21,14 @@ packages=(
   libserialport-dev      # the serial driver: ports by path or USB id, settings (drivers)
   libnlopt-cxx-dev       # the quaternion spline optimiser (core)
 )
+# The hw tests' VM (tests/hw/vm/): Debian's own kernel under qemu, gpio-sim built against its
+# headers, and the tests' independent peers. Only amd64 boots that kernel.
+if [[ $(dpkg --print-architecture) == amd64 ]]; then
+  packages+=(qemu-system-x86 linux-image-amd64 linux-headers-amd64 busybox-static kmod cpio
+             xz-utils zstd file make gcc libc6-dev
+             can-utils python3-can gpiod)
+fi
+packages+=(libgpiod-dev)     # the GPIO line driver (drivers)
 if [[ "${1:-}" == "--plots" ]]; then
   packages+=(python3 python3-matplotlib python3-numpy)
 fi
