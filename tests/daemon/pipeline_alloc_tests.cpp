@@ -29,7 +29,7 @@
 
 #include "../support/counting_allocator.hpp"
 #include "../support/test_files.hpp"
-#include "udp_collector.hpp"
+#include "../support/udp_collector.hpp"
 
 namespace posefair::daemon {
 namespace {

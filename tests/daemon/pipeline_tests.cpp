@@ -24,7 +24,7 @@
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
 #include "posefair/drivers/pose_file.hpp"
-#include "udp_collector.hpp"
+#include "../support/udp_collector.hpp"
 
 namespace posefair::daemon {
 namespace {

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "../protocol/subprocess.hpp"
+#include "udp_collector.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
 
@@ -80,19 +81,10 @@ inline double to_double(const std::string& s) {
 
 inline std::uint64_t to_u64(const std::string& s) { return std::stoull(s); }
 
-inline bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
-  const auto deadline = Clock::now() + timeout;
-  while (!done()) {
-    if (Clock::now() > deadline) return false;
-    std::this_thread::sleep_for(10ms);
-  }
-  return true;
-}
-
 // Waits (bounded) until a child's stderr holds `needle` `occurrences` times; false on timeout
 // or as soon as the child has exited without it.
 inline bool wait_for_log_or_exit(Subprocess& p, const std::string& needle, std::chrono::milliseconds timeout,
-                          std::size_t occurrences = 1) {
+                                 std::size_t occurrences = 1) {
   const auto deadline = Clock::now() + timeout;
   for (;;) {
     const bool alive = p.running();  // first: if it had exited, the log read next is complete
@@ -148,63 +140,6 @@ inline std::vector<std::string> daemon_args(const fs::path& config) {
 }
 
 // Every datagram reaching a socket bound to 127.0.0.1:0, received on a thread of its own.
-class Collector {
- public:
-  struct Got {
-    daemon::PoseMessage m;
-    Clock::time_point at;
-  };
-
-  Collector() {
-    daemon::ReceiveOptions ro;
-    ro.receive_buffer_bytes = 4 << 20;
-    socket_ = daemon::UdpSocket::bind(*daemon::Endpoint::parse("127.0.0.1:0"), ro);
-    thread_ = std::thread([this] { loop(); });
-  }
-  ~Collector() {
-    stop_.store(true);
-    thread_.join();
-  }
-  Collector(const Collector&) = delete;
-  Collector& operator=(const Collector&) = delete;
-
-  std::uint16_t port() const { return socket_.local_endpoint().port(); }
-  std::vector<Got> all() const {
-    std::lock_guard lock(mutex_);
-    return got_;
-  }
-  std::size_t malformed() const {
-    std::lock_guard lock(mutex_);
-    return malformed_;
-  }
-  std::size_t count(std::uint32_t stream) const {
-    std::lock_guard lock(mutex_);
-    return static_cast<std::size_t>(
-        std::count_if(got_.begin(), got_.end(), [&](const Got& g) { return g.m.stream == stream; }));
-  }
-
- private:
-  void loop() {
-    std::vector<std::uint8_t> buffer(daemon::kMaxDatagramSize + 1);
-    while (!stop_.load()) {
-      const auto d = socket_.receive(buffer, 20ms);
-      if (!d) continue;
-      const auto r = d->truncated ? daemon::rejected(daemon::DecodeError::kOversized, daemon::WireEncoding::kBinary)
-                                  : daemon::decode_datagram(std::span<const std::uint8_t>(buffer.data(), d->size));
-      std::lock_guard lock(mutex_);
-      if (r.ok())
-        got_.push_back(Got{r.message, Clock::now()});
-      else
-        ++malformed_;
-    }
-  }
-
-  daemon::UdpSocket socket_;
-  std::thread thread_;
-  std::atomic<bool> stop_{false};
-  mutable std::mutex mutex_;
-  std::vector<Got> got_;
-  std::size_t malformed_ = 0;
-};
+using Collector = UdpCollector;
 
 }  // namespace posefair::testing

@@ -1,8 +1,10 @@
 #pragma once
-// The destination of a daemon::Pipeline's output in the in-process tests (pipeline_tests.cpp,
-// pipeline_alloc_tests.cpp): a UDP socket of the test's own on 127.0.0.1, drained by a thread
-// of its own from the start so the kernel's receive buffer never has to hold a whole run, and
-// every datagram decoded (daemon/wire_protocol.hpp). Also the tests' bounded wait.
+// Where a test's poses go: a UDP socket of the test's own on 127.0.0.1, the destination of an
+// in-process daemon::Pipeline (tests/daemon/pipeline_tests.cpp) or of a posefaird child process
+// (daemon_process.hpp), drained by a thread of its own from the start so the kernel's receive
+// buffer never has to hold a whole run, and every datagram decoded (daemon/wire_protocol.hpp)
+// with its arrival time. Also the tests' bounded wait.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstddef>
@@ -20,6 +22,11 @@ namespace posefair::testing {
 
 class UdpCollector {
  public:
+  struct Got {
+    daemon::PoseMessage m;
+    std::chrono::steady_clock::time_point at;  // arrival
+  };
+
   UdpCollector() {
     daemon::ReceiveOptions ro;
     ro.receive_buffer_bytes = 8 << 20;
@@ -48,7 +55,21 @@ class UdpCollector {
   // The datagrams that decoded, in arrival order.
   std::vector<daemon::PoseMessage> messages() const {
     std::lock_guard lock(mutex_);
-    return messages_;
+    std::vector<daemon::PoseMessage> out;
+    out.reserve(got_.size());
+    for (const Got& g : got_) out.push_back(g.m);
+    return out;
+  }
+  // The same with their arrival times.
+  std::vector<Got> all() const {
+    std::lock_guard lock(mutex_);
+    return got_;
+  }
+  // How many of them belong to `stream`.
+  std::size_t count(std::uint32_t stream) const {
+    std::lock_guard lock(mutex_);
+    return static_cast<std::size_t>(
+        std::count_if(got_.begin(), got_.end(), [&](const Got& g) { return g.m.stream == stream; }));
   }
   // The datagrams that did not (truncated, or refused by the decoder).
   std::size_t malformed() const {
@@ -58,7 +79,7 @@ class UdpCollector {
   // Every datagram received.
   std::size_t datagrams() const {
     std::lock_guard lock(mutex_);
-    return messages_.size() + malformed_;
+    return got_.size() + malformed_;
   }
 
  private:
@@ -76,7 +97,7 @@ class UdpCollector {
                        : daemon::decode_datagram(std::span<const std::uint8_t>(buffer.data(), d->size));
       std::lock_guard lock(mutex_);
       if (r.ok())
-        messages_.push_back(r.message);
+        got_.push_back(Got{r.message, std::chrono::steady_clock::now()});
       else
         ++malformed_;
     }
@@ -86,7 +107,7 @@ class UdpCollector {
   std::thread thread_;
   std::atomic<bool> stop_{false};
   mutable std::mutex mutex_;
-  std::vector<daemon::PoseMessage> messages_;
+  std::vector<Got> got_;
   std::size_t malformed_ = 0;
 };
 
