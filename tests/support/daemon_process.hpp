@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "../protocol/subprocess.hpp"
+#include "test_files.hpp"
 #include "udp_collector.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
@@ -37,18 +38,6 @@ using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 }  // namespace daemon_process_detail
 using namespace daemon_process_detail;
-
-inline void write_text(const fs::path& p, const std::string& text) {
-  // Written whole under another name, then renamed over: the daemon never sees half a file.
-  const fs::path tmp = p.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  fs::rename(tmp, p);
-}
 
 inline std::vector<std::string> split(const std::string& text, char sep) {
   std::vector<std::string> parts;

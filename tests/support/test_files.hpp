@@ -6,12 +6,26 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <system_error>
 #include <vector>
 
 namespace posefair::testing {
+
+// Writes `text` as the whole file: first under another name, then renamed over, so a program
+// reading it (a daemon reloading its config) never sees half a file. Throws when it cannot.
+inline void write_text(const std::filesystem::path& p, std::string_view text) {
+  const std::filesystem::path tmp = p.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << text;
+    out.flush();
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  std::filesystem::rename(tmp, p);
+}
 
 // The whole file, byte for byte ("" when it cannot be read).
 inline std::string slurp(const std::filesystem::path& p) {

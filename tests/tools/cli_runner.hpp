@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
 #include "../support/test_files.hpp"
@@ -13,6 +14,15 @@ struct CliResult {
   int exit_code = -1;
   std::string out, err;
 };
+
+// A path in single quotes for the shell command line of run_posefair (appended piecewise:
+// GCC 12's -Wrestrict misfires on "'" + s + "'").
+inline std::string q(const std::filesystem::path& p) {
+  std::string quoted(1, '\'');
+  quoted.append(p.string());
+  quoted.push_back('\'');
+  return quoted;
+}
 
 inline CliResult run_posefair(const std::string& args, const ScratchDir& dir) {
   const std::string bin = POSEFAIR_BINARY_DIR "/tools/posefair";

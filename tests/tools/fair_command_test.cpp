@@ -16,11 +16,7 @@ namespace {
 using ::testing::HasSubstr;
 using testing::run_posefair;
 using testing::ScratchDir;
-
-void write_text(const std::filesystem::path& p, const std::string& text) {
-  std::ofstream f(p);
-  f << text;
-}
+using testing::write_text;
 
 // A 100-sample TUM file of smooth motion plus noise (positions in metres).
 std::filesystem::path noisy_tum(const ScratchDir& dir) {

@@ -17,20 +17,9 @@ namespace {
 
 using ::testing::HasSubstr;
 using testing::run_posefair;
+using testing::q;
 using testing::ScratchDir;
-
-void write_text(const std::filesystem::path& p, const std::string& text) {
-  std::ofstream f(p);
-  f << text;
-}
-
-// The path in single quotes for the shell (appended piecewise: GCC 12's -Wrestrict misfires on "'" + s + "'").
-std::string q(const std::filesystem::path& p) {
-  std::string quoted(1, '\'');
-  quoted.append(p.string());
-  quoted.push_back('\'');
-  return quoted;
-}
+using testing::write_text;
 
 // A TUM file of 41 samples at 20 Hz: a smooth rotation and translation.
 std::filesystem::path smooth_tum(const ScratchDir& dir) {

@@ -15,22 +15,11 @@ namespace {
 
 using ::testing::HasSubstr;
 using testing::run_posefair;
+using testing::q;
 using testing::ScratchDir;
+using testing::write_text;
 
 const std::string kExample = POSEFAIR_SOURCE_DIR "/docs/examples/quaternion-splines-7keys.txt";
-
-void write_text(const std::filesystem::path& p, const std::string& text) {
-  std::ofstream f(p);
-  f << text;
-}
-
-// The path quoted for the shell.
-std::string q(const std::filesystem::path& p) {
-  std::string s(1, '\'');
-  s.append(p.string());
-  s.push_back('\'');
-  return s;
-}
 
 TEST(QuaternionSplineCommand, ExampleFileIsTheCoreExample) {
   ScratchDir dir;
