@@ -1,6 +1,7 @@
 // `posefair spline` end to end: the real binary on keyframe files, every bad-input case.
 #include <cmath>
 #include <fstream>
+#include <ostream>
 #include <sstream>
 
 #include <gmock/gmock.h>
@@ -105,6 +106,8 @@ struct BadFile {
   const char* text;
   const char* expected;  // in the error message, after "<file>:"
 };
+// ctest shows the case by its name, not as bytes of pointers.
+void PrintTo(const BadFile& f, std::ostream* os) { *os << f.name; }
 
 class QuaternionSplineBadKeyframes : public ::testing::TestWithParam<BadFile> {};
 
