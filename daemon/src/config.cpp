@@ -138,6 +138,13 @@ constexpr std::string_view kSerialKeys[] = {"type",         "device",   "usb",  
                                             "flow_control", "protocol", "witmotion_scalar", "time_source",
                                             "reconnect_min", "reconnect_max", "vectornav_unchecked", "yost_header",
                                             "yost_data_length"};
+constexpr std::string_view kHidKeys[] = {"type",          "device",        "usb",         "serial_number",   "protocol",
+                                         "report_id",     "component_order", "conjugate", "timestamp_count_s",
+                                         "report_length", "value_type",    "byte_order",  "offsets",         "offsets_bits",
+                                         "order",         "scale",         "time_source", "reconnect_min",   "reconnect_max"};
+// [stream.driver] type = "hid": the keys of one HID protocol only.
+constexpr std::string_view kHidSensorOnlyKeys[] = {"component_order", "conjugate", "timestamp_count_s"};
+constexpr std::string_view kHidVendorOnlyKeys[] = {"report_length", "value_type", "byte_order", "offsets", "offsets_bits", "order", "scale"};
 
 // Decoder options (drivers::DecoderOptions), each valid with one protocol only. The decoder
 // judges the value itself (make_decoder throws std::invalid_argument for a bad one).
@@ -163,6 +170,7 @@ const DriverKind kDriverKinds[] = {
     {DriverType::Replay, "replay", kReplayKeys},
     {DriverType::Synthetic, "synthetic", kSyntheticKeys},
     {DriverType::Serial, "serial", kSerialKeys},
+    {DriverType::Hid, "hid", kHidKeys},
 };
 constexpr std::string_view kOutputKeys[] = {"encoding", "destinations", "ttl",          "interface",
                                             "loopback", "streams",      "angular_velocity"};
@@ -678,13 +686,139 @@ class Parser {
     }
   }
 
+  // [stream.driver] with type = "hid" (docs/hid-gpio.md). The device is not opened (nor
+  // required to exist): the driver waits for it, and hid-sensor reads its layout from it.
+  void parse_hid(const toml::table& t, const std::string& prefix, HidSourceConfig& c) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    const toml::node* device = t.get("device");
+    const toml::node* usb = t.get("usb");
+    if (device != nullptr && usb != nullptr)
+      fail(*usb, key("usb"), "give either device or usb, not both (device is set at line " +
+                                 std::to_string(device->source().begin.line) + ")");
+    if (device == nullptr && usb == nullptr)
+      fail(t.source().begin, key("device"), "missing required key: device (a path) or usb (\"VID:PID\")");
+    if (device != nullptr) {
+      const std::string path = get_nonempty_string(*device, key("device"));
+      if (!std::filesystem::path(path).is_absolute())
+        fail(*device, key("device"), "must be an absolute path, e.g. '/dev/hidraw0', got " + in_quotes(path));
+      c.device.device = path;
+    }
+    if (usb != nullptr) {
+      const std::string text = get_string(*usb, key("usb"));
+      c.device.usb = drivers::parse_usb_id(text);
+      if (!c.device.usb)
+        fail(*usb, key("usb"), "not a USB id: " + in_quotes(text) + "; expected VID:PID in hexadecimal, e.g. '0483:5750'");
+    }
+    if (const toml::node* n = t.get("serial_number")) {
+      if (usb == nullptr) fail(*n, key("serial_number"), "only with usb (it selects among devices of one USB id)");
+      c.device.serial = get_nonempty_string(*n, key("serial_number"));
+    }
+
+    const toml::node& protocol_node = require(t, "protocol", prefix);
+    c.protocol = get_choice<drivers::HidProtocol>(protocol_node, key("protocol"),
+                                                  {{"hid-sensor", drivers::HidProtocol::Sensor},
+                                                   {"hid-vendor", drivers::HidProtocol::Vendor}});
+    const bool sensor = c.protocol == drivers::HidProtocol::Sensor;
+    for (std::string_view k : sensor ? std::span<const std::string_view>(kHidVendorOnlyKeys) : std::span<const std::string_view>(kHidSensorOnlyKeys)) {
+      if (const toml::node* n = t.get(k))
+        fail(*n, key(k), std::string("only for protocol ") + (sensor ? "\"hid-vendor\"" : "\"hid-sensor\"") +
+                             " (this source's protocol is " + in_quotes(std::string(to_string(c.protocol))) + ")");
+    }
+    if (sensor)
+      parse_hid_sensor(t, prefix, c.sensor);
+    else
+      parse_hid_vendor(t, prefix, c.vendor);
+
+    if (const toml::node* n = t.get("time_source"))
+      c.time_source = get_choice<drivers::TimeSource>(*n, key("time_source"),
+                                                      {{"auto", drivers::TimeSource::Auto},
+                                                       {"receive", drivers::TimeSource::Receive},
+                                                       {"device", drivers::TimeSource::Device}});
+    const toml::node* min_node = t.get("reconnect_min");
+    const toml::node* max_node = t.get("reconnect_max");
+    if (min_node != nullptr) c.reconnect_min = get_float(*min_node, key("reconnect_min"), FloatRange{0.0, true, 60.0, false});
+    if (max_node != nullptr) c.reconnect_max = get_float(*max_node, key("reconnect_max"), FloatRange{0.0, true, 3600.0, false});
+    if (c.reconnect_max < c.reconnect_min) {
+      if (max_node != nullptr)
+        fail(*max_node, key("reconnect_max"), "must be >= reconnect_min (" + number(c.reconnect_min) + " s), got " + number(c.reconnect_max));
+      fail(*min_node, key("reconnect_min"), "must be <= reconnect_max (" + number(c.reconnect_max) + " s, the default), got " + number(c.reconnect_min));
+    }
+  }
+
+  void parse_hid_sensor(const toml::table& t, const std::string& prefix, drivers::HidSensorOrientationOptions& o) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    // Absent: the first input report with an orientation quaternion; 0: a device without report IDs.
+    if (const toml::node* n = t.get("report_id")) o.report_id = static_cast<int>(get_int(*n, key("report_id"), 0, 255));
+    if (const toml::node* n = t.get("component_order")) {
+      o.component_order = get_string(*n, key("component_order"));
+      std::string sorted = o.component_order;
+      std::sort(sorted.begin(), sorted.end());
+      if (sorted != "wxyz")
+        fail(*n, key("component_order"), "must be the letters w, x, y, z each once in report order, e.g. \"xyzw\" or \"wxyz\", got " +
+                                             in_quotes(o.component_order));
+    }
+    if (const toml::node* n = t.get("conjugate")) o.conjugate = get_bool(*n, key("conjugate"));
+    if (const toml::node* n = t.get("timestamp_count_s")) o.timestamp_count_s = get_float(*n, key("timestamp_count_s"), kPositive);
+  }
+
+  void parse_hid_vendor(const toml::table& t, const std::string& prefix, drivers::HidVendorLayout& l) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    const toml::node* report_id = t.get("report_id");
+    if (report_id != nullptr) l.report_id = static_cast<int>(get_int(*report_id, key("report_id"), -1, 255));
+    if (report_id != nullptr && l.report_id == 0)
+      fail(*report_id, key("report_id"), "0 is reserved by HID: give the report's ID (1..255), or -1 for a device without report IDs");
+    const toml::node* length = t.get("report_length");
+    if (length != nullptr) l.report_length = static_cast<std::uint32_t>(get_int(*length, key("report_length"), 0, 16384));
+    if (const toml::node* n = t.get("value_type"))
+      l.type = get_choice<drivers::HidVendorType>(*n, key("value_type"),
+                                                  {{"int16", drivers::HidVendorType::Int16}, {"int32", drivers::HidVendorType::Int32},
+                                                   {"float32", drivers::HidVendorType::Float32}, {"float64", drivers::HidVendorType::Float64}});
+    if (const toml::node* n = t.get("byte_order"))
+      l.big_endian = get_choice<bool>(*n, key("byte_order"), {{"little", false}, {"big", true}});
+    if (const toml::node* n = t.get("order"))
+      l.w_first = get_choice<bool>(*n, key("order"), {{"w-first", true}, {"w-last", false}});
+    const toml::node* scale = t.get("scale");
+    if (scale != nullptr) {
+      l.scale = get_float(*scale, key("scale"), FloatRange{});
+      if (l.scale == 0.0) fail(*scale, key("scale"), "must not be 0 (value = raw * scale)");
+    }
+    const toml::node* bytes = t.get("offsets");
+    const toml::node* bits = t.get("offsets_bits");
+    if (bytes != nullptr && bits != nullptr)
+      fail(*bits, key("offsets_bits"), "give either offsets (bytes) or offsets_bits, not both (offsets is set at line " +
+                                           std::to_string(bytes->source().begin.line) + ")");
+    if (bytes == nullptr && bits == nullptr)
+      fail(t.source().begin, key("offsets"), "missing required key: offsets (four byte offsets) or offsets_bits");
+    const toml::node& offsets = bytes != nullptr ? *bytes : *bits;
+    const std::string offsets_key = key(bytes != nullptr ? "offsets" : "offsets_bits");
+    if (!offsets.is_array() || offsets.as_array()->size() != 4)
+      fail(offsets, offsets_key, "expected an array of four offsets (the values in report order), e.g. [0, 2, 4, 6]");
+    const toml::array& a = *offsets.as_array();
+    const std::uint32_t unit = bytes != nullptr ? 8 : 1;
+    for (std::size_t k = 0; k < 4; ++k)
+      l.offset_bits[k] = static_cast<std::uint32_t>(get_int(a[k], element_key(offsets_key, k), 0, 16384 * 8 / unit)) * unit;
+    try {
+      drivers::validate_hid_vendor_layout(l);
+    } catch (const drivers::HidVendorLayoutError& e) {
+      const std::string& f = e.field();
+      if (f.starts_with("offset_bits[")) {
+        const std::size_t k = static_cast<std::size_t>(f[12] - '0');
+        fail(a[k], element_key(offsets_key, k), e.what());
+      }
+      const toml::node* at = f == "report_length" ? length : f == "report_id" ? report_id : f == "scale" ? scale : nullptr;
+      if (at != nullptr) fail(*at, key(f), e.what());
+      fail(t.source().begin, key(f), e.what());
+    }
+  }
+
   // [stream.driver]; returns a synthetic driver's rate (the engine's default rate_hz).
   std::optional<Given<double>> parse_driver(const toml::table& t, const std::string& prefix, StreamConfig& s) const {
     const std::string type_key = join_key(prefix, "type");
     const toml::node& type_node = require(t, "type", prefix);
     s.driver.type = get_choice<DriverType>(
         type_node, type_key,
-        {{"replay", DriverType::Replay}, {"synthetic", DriverType::Synthetic}, {"serial", DriverType::Serial}});
+        {{"replay", DriverType::Replay}, {"synthetic", DriverType::Synthetic}, {"serial", DriverType::Serial},
+         {"hid", DriverType::Hid}});
     const DriverKind* own = &kDriverKinds[0];
     for (const DriverKind& k : kDriverKinds)
       if (k.type == s.driver.type) own = &k;
@@ -704,6 +838,10 @@ class Parser {
     }
     if (s.driver.type == DriverType::Serial) {
       parse_serial(t, prefix, s.driver.serial);
+      return std::nullopt;
+    }
+    if (s.driver.type == DriverType::Hid) {
+      parse_hid(t, prefix, s.driver.hid);
       return std::nullopt;
     }
     const bool replay = s.driver.type == DriverType::Replay;

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "posefair/drivers/hidraw_driver.hpp"
 #include "posefair/drivers/replay_driver.hpp"
 #include "posefair/drivers/serial_driver.hpp"
 #include "posefair/drivers/synthetic_driver.hpp"
@@ -112,6 +113,29 @@ MadeDriver make_serial(const StreamConfig& stream) {
   return made;
 }
 
+MadeDriver make_hid(const StreamConfig& stream) {
+  const HidSourceConfig& hc = stream.driver.hid;
+  drivers::HidrawDriverOptions o;
+  o.device = hc.device;
+  o.protocol = hc.protocol;
+  o.sensor = hc.sensor;
+  o.vendor = hc.vendor;
+  o.stream_id = stream.id;
+  o.reconnect_min = hc.reconnect_min;
+  o.reconnect_max = hc.reconnect_max;
+  o.time_source = hc.time_source;
+  o.log = to_spdlog(stream.name);
+  MadeDriver made;
+  made.source = "hid:" + hc.device.describe() + " (" + std::string(drivers::to_string(hc.protocol)) + ")";
+  o.name = made.source;
+  try {
+    made.driver = std::make_unique<drivers::HidrawDriver>(std::move(o));
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("stream '" + stream.name + "': " + e.what());
+  }
+  return made;
+}
+
 }  // namespace
 
 MadeDriver make_driver(const StreamConfig& stream) {
@@ -122,6 +146,8 @@ MadeDriver make_driver(const StreamConfig& stream) {
       return make_synthetic(stream);
     case DriverType::Serial:
       return make_serial(stream);
+    case DriverType::Hid:
+      return make_hid(stream);
   }
   throw std::logic_error("make_driver: unknown driver type");
 }

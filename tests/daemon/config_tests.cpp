@@ -412,6 +412,69 @@ driver = { type = "serial", device = "/dev/ttyUSB1", protocol = "yost", yost_hea
   EXPECT_EQ(c.streams[1].driver.serial.decoder.yost_data_length, "16");
 }
 
+TEST(Config, HidSourcesOfBothProtocolsAreParsed) {
+  const DaemonConfig c = parse_config(R"([[stream]]
+id = 1
+name = "st"
+[stream.driver]
+type = "hid"
+usb = "0483:5750"
+serial_number = "2053386B5650"
+protocol = "hid-sensor"
+component_order = "wxyz"
+report_id = 8
+conjugate = true
+timestamp_count_s = 1e-3
+time_source = "receive"
+reconnect_min = 0.5
+reconnect_max = 10
+[[stream]]
+id = 2
+name = "vendor"
+driver = { type = "hid", device = "/dev/hidraw3", protocol = "hid-vendor", report_id = 2, report_length = 20, value_type = "float32", byte_order = "big", offsets = [4, 8, 12, 16], order = "w-last", scale = 2.0 }
+[[stream]]
+id = 3
+name = "bits"
+driver = { type = "hid", device = "/dev/hidraw4", protocol = "hid-vendor", offsets_bits = [4, 20, 36, 52] }
+)", "/virtual/hid.toml");
+  ASSERT_EQ(c.streams.size(), 3u);
+  ASSERT_EQ(c.streams[0].driver.type, DriverType::Hid);
+  const HidSourceConfig& a = c.streams[0].driver.hid;
+  ASSERT_TRUE(a.device.usb);
+  EXPECT_EQ(a.device.usb->vid, 0x0483);
+  EXPECT_EQ(a.device.usb->pid, 0x5750);
+  EXPECT_EQ(a.device.serial, "2053386B5650");
+  EXPECT_EQ(a.device.device, "");
+  EXPECT_EQ(a.protocol, drivers::HidProtocol::Sensor);
+  EXPECT_EQ(a.sensor.component_order, "wxyz");
+  EXPECT_EQ(a.sensor.report_id, 8);
+  EXPECT_TRUE(a.sensor.conjugate);
+  EXPECT_EQ(a.sensor.timestamp_count_s, 1e-3);
+  EXPECT_EQ(a.time_source, drivers::TimeSource::Receive);
+  EXPECT_EQ(a.reconnect_min, 0.5);
+  EXPECT_EQ(a.reconnect_max, 10.0);
+
+  const HidSourceConfig& b = c.streams[1].driver.hid;
+  EXPECT_EQ(b.device.device, "/dev/hidraw3");
+  EXPECT_FALSE(b.device.usb);
+  EXPECT_EQ(b.protocol, drivers::HidProtocol::Vendor);
+  EXPECT_EQ(b.vendor.report_id, 2);
+  EXPECT_EQ(b.vendor.report_length, 20u);
+  EXPECT_EQ(b.vendor.type, drivers::HidVendorType::Float32);
+  EXPECT_TRUE(b.vendor.big_endian);
+  EXPECT_EQ(b.vendor.offset_bits, (std::array<std::uint32_t, 4>{32, 64, 96, 128}));
+  EXPECT_FALSE(b.vendor.w_first);
+  EXPECT_EQ(b.vendor.scale, 2.0);
+  EXPECT_EQ(b.time_source, drivers::TimeSource::Auto);
+
+  const HidSourceConfig& d = c.streams[2].driver.hid;
+  EXPECT_EQ(d.vendor.report_id, -1);  // the default: no report ID byte
+  EXPECT_EQ(d.vendor.type, drivers::HidVendorType::Int16);
+  EXPECT_EQ(d.vendor.offset_bits, (std::array<std::uint32_t, 4>{4, 20, 36, 52}));
+  EXPECT_TRUE(d.vendor.w_first);
+  EXPECT_EQ(d.vendor.scale, 1.0 / 16384.0);
+}
+
 TEST(Config, TheSplineTableSetsBridgingAndResampling) {
   const DaemonConfig c = parse_config(R"toml(
 [[stream]]
@@ -674,7 +737,7 @@ id = 1
 name = "a"
 [stream.driver]
 type = "socketcan"
-)", "stream[1].driver.type: expected one of 'replay', 'synthetic', 'serial', got 'socketcan'", 5},
+)", "stream[1].driver.type: expected one of 'replay', 'synthetic', 'serial', 'hid', got 'socketcan'", 5},
     {"replay key on a synthetic driver", R"([[stream]]
 id = 1
 name = "a"
@@ -983,6 +1046,137 @@ id = 1
 name = "a"
 driver = { type = "serial", device = "/dev/ttyUSB0", time_source = "devise", protocol = "witmotion" }
 )", "stream[1].driver.time_source: expected one of 'auto', 'receive', 'device', got 'devise' (did you mean 'device'?)", 4},
+    {"hid: neither device nor usb", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "hid"
+protocol = "hid-sensor"
+)", "stream[1].driver.device: missing required key: device (a path) or usb (\"VID:PID\")", 4},
+    {"hid: relative device path", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", device = "hidraw0", protocol = "hid-sensor" }
+)", "stream[1].driver.device: must be an absolute path, e.g. '/dev/hidraw0', got 'hidraw0'", 4},
+    {"hid: bad usb id", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", usb = "0483-5750", protocol = "hid-sensor" }
+)", "stream[1].driver.usb: not a USB id: '0483-5750'", 4},
+    {"hid: serial_number without usb", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", device = "/dev/hidraw0", serial_number = "X", protocol = "hid-sensor" }
+)", "stream[1].driver.serial_number: only with usb", 4},
+    {"hid: protocol missing", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "hid"
+device = "/dev/hidraw0"
+)", "stream[1].driver.protocol: missing required key", 4},
+    {"hid: a serial protocol", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", device = "/dev/hidraw0", protocol = "witmotion" }
+)", "stream[1].driver.protocol: expected one of 'hid-sensor', 'hid-vendor', got 'witmotion'", 4},
+    {"hid: component_order not a permutation", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", device = "/dev/hidraw0", protocol = "hid-sensor", component_order = "xyzx" }
+)", "stream[1].driver.component_order: must be the letters w, x, y, z each once in report order", 4},
+    {"hid: sensor report_id above 255", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", device = "/dev/hidraw0", protocol = "hid-sensor", report_id = 256 }
+)", "stream[1].driver.report_id: out of range: must be in [0, 255], got 256", 4},
+    {"hid: timestamp_count_s of 0", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", device = "/dev/hidraw0", protocol = "hid-sensor", timestamp_count_s = 0 }
+)", "stream[1].driver.timestamp_count_s: out of range: must be > 0, got 0", 4},
+    {"hid: a vendor key with hid-sensor", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "hid"
+device = "/dev/hidraw0"
+protocol = "hid-sensor"
+scale = 0.001
+)", "stream[1].driver.scale: only for protocol \"hid-vendor\" (this source's protocol is 'hid-sensor')", 8},
+    {"hid: a sensor key with hid-vendor", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", device = "/dev/hidraw0", protocol = "hid-vendor", offsets = [0, 2, 4, 6], conjugate = true }
+)", "stream[1].driver.conjugate: only for protocol \"hid-sensor\"", 4},
+    {"hid: vendor without offsets", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "hid"
+device = "/dev/hidraw0"
+protocol = "hid-vendor"
+)", "stream[1].driver.offsets: missing required key: offsets (four byte offsets) or offsets_bits", 4},
+    {"hid: vendor offsets and offsets_bits", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "hid"
+device = "/dev/hidraw0"
+protocol = "hid-vendor"
+offsets = [0, 2, 4, 6]
+offsets_bits = [0, 16, 32, 48]
+)", "stream[1].driver.offsets_bits: give either offsets (bytes) or offsets_bits, not both (offsets is set at line 8)", 9},
+    {"hid: vendor three offsets", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", device = "/dev/hidraw0", protocol = "hid-vendor", offsets = [0, 2, 4] }
+)", "stream[1].driver.offsets: expected an array of four offsets", 4},
+    {"hid: vendor overlapping offsets, judged by the layout", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "hid"
+device = "/dev/hidraw0"
+protocol = "hid-vendor"
+value_type = "int32"
+offsets = [0, 4, 8, 10]
+)", "stream[1].driver.offsets[4]: hid-vendor layout: offset_bits[3]: the value at bit 80 overlaps value 2 at bit 64 (32 bits each)", 9},
+    {"hid: vendor offset past report_length", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "hid"
+device = "/dev/hidraw0"
+protocol = "hid-vendor"
+report_length = 7
+offsets = [0, 2, 4, 6]
+)", "stream[1].driver.offsets[4]: hid-vendor layout: offset_bits[3]: the value at bit 48 ends at bit 64, past report_length 7 bytes", 9},
+    {"hid: vendor report_id 0", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", device = "/dev/hidraw0", protocol = "hid-vendor", report_id = 0, offsets = [0, 2, 4, 6] }
+)", "stream[1].driver.report_id: 0 is reserved by HID", 4},
+    {"hid: vendor scale 0", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", device = "/dev/hidraw0", protocol = "hid-vendor", offsets = [0, 2, 4, 6], scale = 0 }
+)", "stream[1].driver.scale: must not be 0", 4},
+    {"hid: vendor value type typo", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", device = "/dev/hidraw0", protocol = "hid-vendor", offsets = [0, 2, 4, 6], value_type = "int8" }
+)", "stream[1].driver.value_type: expected one of 'int16', 'int32', 'float32', 'float64', got 'int8'", 4},
+    {"hid: a serial key", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", device = "/dev/hidraw0", protocol = "hid-sensor", baud = 9600 }
+)", "stream[1].driver.baud: unknown key for driver type hid (it belongs to type serial)", 4},
+    {"hid: reconnect_max below reconnect_min", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "hid", device = "/dev/hidraw0", protocol = "hid-sensor", reconnect_min = 2, reconnect_max = 1 }
+)", "stream[1].driver.reconnect_max: must be >= reconnect_min (2 s), got 1", 4},
     {"spline: a rate of zero", R"([[stream]]
 id = 1
 name = "a"

@@ -19,6 +19,7 @@
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
 #include "posefair/drivers/decoder.hpp"
+#include "posefair/drivers/hidraw_driver.hpp"
 #include "posefair/drivers/replay_driver.hpp"
 #include "posefair/drivers/serial_port.hpp"
 #include "posefair/drivers/time_base.hpp"
@@ -99,13 +100,27 @@ struct SerialSourceConfig {
   double reconnect_max = 5.0;         // s, >= reconnect_min
 };
 
-enum class DriverType { Replay, Synthetic, Serial };
+// [stream.driver] with type = "hid": a HID device through hidraw (drivers/hidraw_driver.hpp),
+// opened by path or by USB id, its reports read by the hid-sensor or hid-vendor decoder. The
+// device need not exist at load: the driver waits for it.
+struct HidSourceConfig {
+  drivers::HidDeviceSpec device;                 // device (absolute path) or usb (+ serial_number)
+  drivers::HidProtocol protocol = drivers::HidProtocol::Sensor;
+  drivers::HidSensorOrientationOptions sensor;   // component_order, report_id, conjugate, timestamp_count_s
+  drivers::HidVendorLayout vendor;               // report_id, report_length, type, byte_order, offsets, order, scale
+  drivers::TimeSource time_source = drivers::TimeSource::Auto;
+  double reconnect_min = 0.1;                    // s
+  double reconnect_max = 5.0;                    // s, >= reconnect_min
+};
+
+enum class DriverType { Replay, Synthetic, Serial, Hid };
 
 struct DriverConfig {
   DriverType type = DriverType::Replay;
   ReplaySourceConfig replay;        // type == Replay
   SyntheticSourceConfig synthetic;  // type == Synthetic
   SerialSourceConfig serial;        // type == Serial
+  HidSourceConfig hid;              // type == Hid
 };
 
 // [stream.spline]: the geometric spline around the fairing window (docs/splines.md, "In the
