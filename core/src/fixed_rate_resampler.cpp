@@ -46,6 +46,7 @@ std::uint32_t FixedRateResampler::flags_between(double t) const {
 }
 
 std::size_t FixedRateResampler::push(const FairedPose& pose, std::span<FairedPose> out) {
+  if (options_.interpolation == PoseInterpolation::MatrixLerp) return push_lerp(pose, out);
   if (have_last_ && !(pose.time > last_time_)) return 0;
   const bool restart = have_last_ && pose.time - last_time_ > options_.max_step;
   if (restart) {
@@ -79,6 +80,48 @@ std::size_t FixedRateResampler::push(const FairedPose& pose, std::span<FairedPos
     g.flags = flags_between(t);
     g.orientation = p.orientation;
     g.position = (g.flags & kHasPosition) ? p.position : Vec3::Zero();
+    g.measured = g.orientation;  // nothing was measured at a grid time
+    g.measured_position = g.position;
+  }
+  return n;
+}
+
+// The grid times in [last_.time, pose.time], each lerped between the two faired poses.
+std::size_t FixedRateResampler::push_lerp(const FairedPose& pose, std::span<FairedPose> out) {
+  if (have_last_ && !(pose.time > last_time_)) return 0;
+  const bool restart = have_last_ && pose.time - last_time_ > options_.max_step;
+  if (restart) ++restarts_;
+  if (!have_last_ || restart) {
+    next_ = static_cast<std::int64_t>(std::ceil(pose.time * options_.rate_hz));
+    have_last_ = true;
+    last_time_ = pose.time;
+    last_ = pose;
+    return 0;
+  }
+  const FairedPose a = last_;
+  last_ = pose;
+  last_time_ = pose.time;
+  // Grid times left behind (out was too short last time) are skipped, not extrapolated.
+  while (static_cast<double>(next_) * period_ < a.time) ++next_;
+  if (static_cast<double>(next_) * period_ > pose.time) return 0;  // no grid time here: no logarithm
+
+  const bool position = (a.flags & kHasPosition) && (pose.flags & kHasPosition);
+  lerp_.prepare(a.orientation, position ? a.position : Vec3::Zero(), pose.orientation,
+                position ? pose.position : Vec3::Zero());
+  const std::uint32_t flags = ((a.flags | pose.flags) & kBridged) | (position ? kHasPosition : 0u);
+  const double span = pose.time - a.time;
+  std::size_t n = 0;
+  while (n < out.size() && n < max_outputs_) {
+    const double t = static_cast<double>(next_) * period_;
+    if (t > pose.time) break;
+    ++next_;
+    FairedPose& g = out[n++];
+    g.stream_id = pose.stream_id;
+    g.sequence = pose.sequence;
+    g.time = t;
+    g.flags = flags;
+    lerp_.at((t - a.time) / span, g.orientation, g.position);
+    if (!position) g.position = Vec3::Zero();
     g.measured = g.orientation;  // nothing was measured at a grid time
     g.measured_position = g.position;
   }

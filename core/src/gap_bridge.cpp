@@ -49,6 +49,7 @@ std::size_t GapBridge::push(const Sample& s, std::span<Sample> out) {
   if (!knot.has_position()) knot.position = Vec3::Zero();
   if (have_last_ && interval_ > 0.0 && dt > kGapFactor * interval_) {
     if (dt <= options_.max_gap) {
+      if (options_.interpolation == PoseInterpolation::MatrixLerp) return lerp_across(s, out);
       spline_.push(knot.time, knot.orientation, knot.position);
       holding_ = true;
       held_ = s;
@@ -117,6 +118,37 @@ std::size_t GapBridge::release(const Sample& current, std::span<Sample> out) {
   }
   before_ = current;
   out[n++] = current;
+  return n;
+}
+
+// The sample after a gap has arrived, and the lerp needs nothing more: fill the gap from
+// before_ to it at once.
+std::size_t GapBridge::lerp_across(const Sample& after, std::span<Sample> out) {
+  const double gap = after.time - before_.time;
+  const auto missing = static_cast<std::size_t>(std::max(1.0, std::round(gap / interval_)) - 1.0);
+  const std::size_t m = std::min(missing, options_.max_bridged);
+  std::size_t n = 0;
+  if (m > 0) {
+    const bool position = before_.has_position() && after.has_position();
+    lerp_.prepare(before_.orientation, position ? before_.position : Vec3::Zero(), after.orientation,
+                  position ? after.position : Vec3::Zero());
+    for (std::size_t j = 1; j <= m; ++j) {
+      const double f = static_cast<double>(j) / static_cast<double>(m + 1);
+      Sample b = after;
+      b.time = before_.time + gap * f;
+      b.device_time = 0.0;
+      lerp_.at(f, b.orientation, b.position);
+      if (!position) b.position = Vec3::Zero();
+      b.flags = kBridged | (position ? kHasPosition : 0u);
+      out[n++] = b;
+    }
+    ++counters_.gaps;
+    counters_.samples += m;
+    counters_.lerp_fallbacks = lerp_.fallbacks();
+  }
+  out[n++] = after;
+  before_ = after;
+  last_time_ = after.time;
   return n;
 }
 

@@ -129,8 +129,9 @@ MatrixResult matrix_log(const Mat4& a_in, const LogOptions& o, LogTrace* trace) 
       return error(MatrixErrorCode::NoConvergence,
                    "logarithm: %g square roots did not bring |A - I| = %.3g below eps1 = %.3g", k, norm_inf(a - id),
                    o.epsilon1);
+    // Traced only when asked: the trace's residual list allocates (the daemon's lerp must not).
     SqrtTrace st;
-    MatrixResult r = sqrt_iteration(a, o.sqrt, &st);
+    MatrixResult r = sqrt_iteration(a, o.sqrt, trace ? &st : nullptr);
     sqrt_iterations += st.iterations;
     if (!r) {
       MatrixError e = r.error();

@@ -129,7 +129,7 @@ constexpr std::string_view kEngineKeys[] = {
     "smoothing_t", "cutoff_hz", "rate_hz", "continuity", "lambda_r", "lambda_t", "variant",
     "epsilon_r", "epsilon_t", "bound",  "gap",       "unit_tolerance"};
 constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "overflow", "driver", "engine", "spline"};
-constexpr std::string_view kSplineKeys[] = {"publish_rate_hz", "bridge_gap", "order", "manifold", "velocity"};
+constexpr std::string_view kSplineKeys[] = {"publish_rate_hz", "bridge_gap", "order", "manifold", "velocity", "pose_interpolation"};
 constexpr std::string_view kReplayKeys[] = {"type",   "path",   "timing",     "speed",        "schedule",     "loop",
                                             "rounds", "format", "joint",      "csv_prefix",   "skip_missing", "source_stream"};
 constexpr std::string_view kSyntheticKeys[] = {"type", "rate_hz", "duration", "rotation_noise", "with_position", "seed", "phase"};
@@ -942,7 +942,23 @@ class Parser {
       // The fit looks several knots ahead: more delay, and the gap bridge holds only one sample.
       c.spline.velocity.estimator = get_choice<gs::KnotVelocityEstimator>(
           *n, key("velocity"), {{"bessel", gs::KnotVelocityEstimator::Bessel}, {"central", gs::KnotVelocityEstimator::CentralDifference}});
+    parse_pose_interpolation(t, prefix, c);
     return c;
+  }
+
+  // pose_interpolation: "matrix-lerp" lerps between the two neighbouring samples (C^0) and uses
+  // no spline, so the spline's own keys would be silently ignored: they are refused with it.
+  void parse_pose_interpolation(const toml::table& t, const std::string& prefix, SplineConfig& c) const {
+    const toml::node* n = t.get("pose_interpolation");
+    if (!n) return;
+    c.pose_interpolation = get_choice<PoseInterpolation>(
+        *n, join_key(prefix, "pose_interpolation"), {{"spline", PoseInterpolation::Spline}, {"matrix-lerp", PoseInterpolation::MatrixLerp}});
+    if (c.pose_interpolation != PoseInterpolation::MatrixLerp) return;
+    for (std::string_view k : {"order", "manifold", "velocity"})
+      if (const toml::node* s = t.get(k))
+        fail(*s, join_key(prefix, k),
+             "has no meaning with pose_interpolation = 'matrix-lerp' (a lerp between the two neighbouring samples, "
+             "no spline); remove it, or use pose_interpolation = 'spline'");
   }
 
   OutputConfig parse_output(const toml::node& node, const std::string& prefix, const std::vector<StreamConfig>& streams) const {

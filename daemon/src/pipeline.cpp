@@ -60,6 +60,7 @@ struct Pipeline::Stream final : drivers::SampleSink {
       GapBridgeOptions o;
       o.max_gap = c.spline.bridge_gap;
       o.spline = c.spline.spline;
+      o.interpolation = c.spline.pose_interpolation;
       bridge.emplace(o);
       bridged.resize(bridge->max_outputs());
     }
@@ -68,6 +69,7 @@ struct Pipeline::Stream final : drivers::SampleSink {
       o.rate_hz = c.spline.publish_rate_hz;
       o.max_step = c.engine.gate.gap_threshold;  // the window restarts after a longer step
       o.spline = c.spline.spline;
+      o.interpolation = c.spline.pose_interpolation;
       resampler.emplace(o);
       grid.resize(resampler->max_outputs());
     }
@@ -285,6 +287,10 @@ void Pipeline::engine_loop() {
         s.counters.bridged_gaps.store(s.bridge->counters().gaps, std::memory_order_relaxed);
         s.counters.bridged_samples.store(s.bridge->counters().samples, std::memory_order_relaxed);
       }
+      if (s.bridge || s.resampler)
+        s.counters.lerp_fallbacks.store((s.bridge ? s.bridge->counters().lerp_fallbacks : 0) +
+                                            (s.resampler ? s.resampler->lerp_fallbacks() : 0),
+                                        std::memory_order_relaxed);
     }
     if (any) {
       wake_publisher();
@@ -373,6 +379,8 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.bridged_gaps = get(s.counters.bridged_gaps);
     st.bridged_samples = get(s.counters.bridged_samples);
     st.resampled = get(s.counters.resampled);
+    st.matrix_lerp = s.config.spline.pose_interpolation == PoseInterpolation::MatrixLerp;
+    st.lerp_fallbacks = get(s.counters.lerp_fallbacks);
     out.push_back(std::move(st));
   }
   return out;

@@ -61,6 +61,10 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
       std::snprintf(buf, sizeof buf, ", resampled %" PRIu64, s.resampled);
       lines.back() += buf;
     }
+    if (s.matrix_lerp && (s.bridging || s.resampling)) {
+      std::snprintf(buf, sizeof buf, ", lerp fallbacks %" PRIu64, s.lerp_fallbacks);
+      lines.back() += buf;
+    }
     if (s.device) lines.back() += device_text(*s.device);
   }
   return lines;

@@ -1,6 +1,7 @@
 // Live resampling and gap bridging (core/fixed_rate_resampler.hpp, core/gap_bridge.hpp): the
 // engine thread's cost per faired pose and per grid pose, and the delay resampling adds, for a
-// 100 Hz stream published at 250 Hz and at 90 Hz with each spline order.
+// 100 Hz stream published at 250 Hz and at 90 Hz with each spline order, and with
+// pose_interpolation = "matrix-lerp" (Alexa's lerp of the 4x4 transform, rigid_pose_lerp.hpp).
 //   build/tests/bench/resampling_bench
 // Counters: ns_per_grid_pose, and delay_ms_mean / delay_ms_max = (time of the faired pose that
 // completed a grid pose) - (the grid pose's time): what the spline's lookahead adds to the
@@ -13,6 +14,7 @@
 
 #include "posefair/core/fixed_rate_resampler.hpp"
 #include "posefair/core/gap_bridge.hpp"
+#include "posefair/core/rigid_pose_lerp.hpp"
 
 namespace {
 
@@ -27,11 +29,7 @@ FairedPose pose_at(double t) {
   return p;
 }
 
-// args: output rate (Hz), spline order
-void BM_ResampleA100HzStream(benchmark::State& state) {
-  FixedRateResamplerOptions o;
-  o.rate_hz = static_cast<double>(state.range(0));
-  o.spline.order = static_cast<int>(state.range(1));
+void resample(benchmark::State& state, const FixedRateResamplerOptions& o) {
   constexpr int kPoses = 1000;
   std::vector<FairedPose> input;
   for (int i = 0; i < kPoses; ++i) input.push_back(pose_at(0.0013 + 0.01 * i));
@@ -61,15 +59,59 @@ void BM_ResampleA100HzStream(benchmark::State& state) {
   state.counters["delay_ms_mean"] = 1000.0 * delay_sum / static_cast<double>(std::max<std::size_t>(grid, 1));
   state.counters["delay_ms_max"] = 1000.0 * delay_max;
 }
+
+// args: output rate (Hz), spline order
+void BM_ResampleA100HzStream(benchmark::State& state) {
+  FixedRateResamplerOptions o;
+  o.rate_hz = static_cast<double>(state.range(0));
+  o.spline.order = static_cast<int>(state.range(1));
+  resample(state, o);
+}
 BENCHMARK(BM_ResampleA100HzStream)
     ->ArgsProduct({{250, 90}, {1, 2, 3}})
     ->ArgNames({"rate_hz", "k"})
     ->Unit(benchmark::kMicrosecond);
 
+// args: output rate (Hz). pose_interpolation = "matrix-lerp": one logarithm per input interval
+// that has a grid time in it, one exponential per grid pose.
+void BM_ResampleA100HzStreamMatrixLerp(benchmark::State& state) {
+  FixedRateResamplerOptions o;
+  o.rate_hz = static_cast<double>(state.range(0));
+  o.interpolation = PoseInterpolation::MatrixLerp;
+  resample(state, o);
+}
+BENCHMARK(BM_ResampleA100HzStreamMatrixLerp)->Arg(250)->Arg(90)->ArgName("rate_hz")->Unit(benchmark::kMicrosecond);
+
+// One interval prepared (a matrix logarithm), and one pose in it (an exponential and a product),
+// for two poses of the 100 Hz stream 10 ms apart.
+void BM_RigidPoseLerpPrepare(benchmark::State& state) {
+  const FairedPose a = pose_at(0.5), b = pose_at(0.51);
+  RigidPoseLerp lerp;
+  for (auto _ : state) benchmark::DoNotOptimize(lerp.prepare(a.orientation, a.position, b.orientation, b.position));
+}
+BENCHMARK(BM_RigidPoseLerpPrepare)->Unit(benchmark::kNanosecond);
+void BM_RigidPoseLerpEvaluate(benchmark::State& state) {
+  const FairedPose a = pose_at(0.5), b = pose_at(0.51);
+  RigidPoseLerp lerp;
+  lerp.prepare(a.orientation, a.position, b.orientation, b.position);
+  Quat q;
+  Vec3 p;
+  double f = 0.0;
+  for (auto _ : state) {
+    lerp.at(f, q, p);
+    benchmark::DoNotOptimize(q);
+    benchmark::DoNotOptimize(p);
+    f = f > 0.9 ? 0.0 : f + 0.1;
+  }
+}
+BENCHMARK(BM_RigidPoseLerpEvaluate)->Unit(benchmark::kNanosecond);
+
 // A 100 Hz stream with a 60 ms dropout every second: cost per input sample through the bridge.
+// arg: 0 = spline, 1 = matrix-lerp
 void BM_BridgeA100HzStreamWithDropouts(benchmark::State& state) {
   GapBridgeOptions o;
   o.max_gap = 0.1;
+  o.interpolation = state.range(0) ? PoseInterpolation::MatrixLerp : PoseInterpolation::Spline;
   std::vector<Sample> input;
   for (int i = 0; i < 1000; ++i) {
     if (i % 100 >= 94) continue;
@@ -92,7 +134,7 @@ void BM_BridgeA100HzStreamWithDropouts(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * input.size()));
   state.counters["samples_out"] = static_cast<double>(made);
 }
-BENCHMARK(BM_BridgeA100HzStreamWithDropouts)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_BridgeA100HzStreamWithDropouts)->Arg(0)->Arg(1)->ArgName("matrix_lerp")->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

@@ -507,6 +507,35 @@ velocity = "central"
   EXPECT_EQ(s.spline.velocity.estimator, geometric_splines::KnotVelocityEstimator::CentralDifference);
 }
 
+TEST(Config, PoseInterpolationIsTheSplineUnlessMatrixLerpIsChosen) {
+  const DaemonConfig c = parse_config(R"toml(
+[[stream]]
+id = 1
+name = "default"
+driver = { type = "synthetic" }
+spline = { publish_rate_hz = 90.0 }
+
+[[stream]]
+id = 2
+name = "explicit"
+driver = { type = "synthetic" }
+spline = { publish_rate_hz = 90.0, order = 1, pose_interpolation = "spline" }
+
+[[stream]]
+id = 3
+name = "matrix"
+driver = { type = "synthetic" }
+spline = { publish_rate_hz = 90.0, bridge_gap = 0.1, pose_interpolation = "matrix-lerp" }
+)toml",
+                                      "lerp.toml");
+  ASSERT_EQ(c.streams.size(), 3u);
+  EXPECT_EQ(c.streams[0].spline.pose_interpolation, PoseInterpolation::Spline);
+  EXPECT_EQ(c.streams[1].spline.pose_interpolation, PoseInterpolation::Spline);
+  EXPECT_EQ(c.streams[1].spline.spline.order, 1);
+  EXPECT_EQ(c.streams[2].spline.pose_interpolation, PoseInterpolation::MatrixLerp);
+  EXPECT_TRUE(c.streams[2].spline.bridging());
+}
+
 TEST(Config, TheMostSpecificTableDecidesTheSmoothing) {
   testing::ScratchDir dir("posefair-config-");
   write_file(dir / "poses.csv", "t,qw,qx,qy,qz\n0,1,0,0,0\n");
@@ -1205,6 +1234,29 @@ driver = { type = "synthetic" }
 [stream.spline]
 rate_hz = 90.0
 )", "stream[1].spline.rate_hz: unknown key", 6},
+    {"spline: pose_interpolation typo", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.spline]
+publish_rate_hz = 90.0
+pose_interpolation = "matrix"
+)", "stream[1].spline.pose_interpolation: expected one of 'spline', 'matrix-lerp', got 'matrix'", 7},
+    {"spline: matrix-lerp with an order", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.spline]
+publish_rate_hz = 90.0
+order = 1
+pose_interpolation = "matrix-lerp"
+)", "stream[1].spline.order: has no meaning with pose_interpolation = 'matrix-lerp'", 7},
+    {"spline: matrix-lerp with a velocity estimate", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+spline = { bridge_gap = 0.1, pose_interpolation = "matrix-lerp", velocity = "central" }
+)", "stream[1].spline.velocity: has no meaning with pose_interpolation = 'matrix-lerp'", 5},
     {"a table that is not one", R"(daemon = 5
 [[stream]]
 id = 1

@@ -780,22 +780,34 @@ TEST(DaemonSerial, AGoldenLogThroughAPtyIsFairedAndTheLinkIsReported) {
 namespace posefair::testing {
 namespace {
 
-TEST(DaemonSpline, AReplayWithGapsIsBridgedAndPublishedOnA250HzGrid) {
-  ScratchDir dir("posefair-e2e-");
-  Collector poses;
-  // The demo excerpt (285.7 Hz) without rows 500..519 (70 ms) and 1200..1299 (350 ms).
-  const std::vector<std::string> rows = lines_of(slurp(kDemoCsv));
-  std::string csv = rows[0] + "\n";
+// The demo excerpt (285.7 Hz) without rows 500..519 (70 ms) and 1200..1299 (350 ms).
+struct DemoWithGaps {
+  std::string csv;
   std::vector<double> kept_times;
+  double short_from, short_to, long_from, long_to;
+};
+DemoWithGaps demo_with_gaps() {
+  const std::vector<std::string> rows = lines_of(slurp(kDemoCsv));
+  DemoWithGaps g;
+  g.csv = rows[0] + "\n";
   for (std::size_t i = 1; i < rows.size(); ++i) {
     const std::size_t r = i - 1;
     if ((r >= 500 && r < 520) || (r >= 1200 && r < 1300)) continue;
-    csv += rows[i] + "\n";
-    kept_times.push_back(std::stod(rows[i]));
+    g.csv += rows[i] + "\n";
+    g.kept_times.push_back(std::stod(rows[i]));
   }
-  const double short_from = std::stod(rows[500]), short_to = std::stod(rows[521]);  // rows 499 and 520
-  const double long_from = std::stod(rows[1200]), long_to = std::stod(rows[1301]);   // rows 1199 and 1300
-  write_text(dir / "gaps.csv", csv);
+  g.short_from = std::stod(rows[500]), g.short_to = std::stod(rows[521]);  // rows 499 and 520
+  g.long_from = std::stod(rows[1200]), g.long_to = std::stod(rows[1301]);  // rows 1199 and 1300
+  return g;
+}
+
+TEST(DaemonSpline, AReplayWithGapsIsBridgedAndPublishedOnA250HzGrid) {
+  ScratchDir dir("posefair-e2e-");
+  Collector poses;
+  const DemoWithGaps g = demo_with_gaps();
+  const std::vector<double>& kept_times = g.kept_times;
+  const double short_from = g.short_from, short_to = g.short_to, long_from = g.long_from, long_to = g.long_to;
+  write_text(dir / "gaps.csv", g.csv);
   const fs::path config = dir / "posefaird.toml";
   write_text(config, "[daemon]\nexit_when_sources_end = true\n[logging]\nstatus_interval = 0\n\n"
                      "[[stream]]\nid = 1\nname = \"gaps\"\n"
@@ -840,6 +852,49 @@ TEST(DaemonSpline, AReplayWithGapsIsBridgedAndPublishedOnA250HzGrid) {
   EXPECT_EQ(counters->received, 2000u - 120u);
   EXPECT_EQ(counters->published, all.size()) << counters->line;
   EXPECT_NE(counters->line.find(", bridged gaps 1 (samples 20), resampled " + std::to_string(all.size())), std::string::npos)
+      << counters->line;
+  EXPECT_NE(counters->line.find(", restarts 1,"), std::string::npos) << "only the long gap restarts the window: " << counters->line;
+}
+
+// pose_interpolation = "matrix-lerp": the same replay, bridged and resampled with Alexa's lerp of
+// the 4x4 pose (the demo has positions). Nothing is held at the short gap, the grid reaches to
+// within one input interval of the last faired pose, and the counter line shows no fallback.
+TEST(DaemonSpline, MatrixLerpBridgesAndResamplesTheSameReplay) {
+  ScratchDir dir("posefair-e2e-");
+  Collector poses;
+  const DemoWithGaps g = demo_with_gaps();
+  write_text(dir / "gaps.csv", g.csv);
+  const fs::path config = dir / "posefaird.toml";
+  write_text(config, "[daemon]\nexit_when_sources_end = true\n[logging]\nstatus_interval = 0\n\n"
+                     "[[stream]]\nid = 1\nname = \"gaps\"\n"
+                     "driver = { type = \"replay\", path = \"gaps.csv\", timing = \"original\", speed = 5.0 }\n"
+                     "[stream.spline]\npublish_rate_hz = 250.0\nbridge_gap = 0.1\npose_interpolation = \"matrix-lerp\"\n\n"
+                     "[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(poses.port()) + "\"]\n");
+  Subprocess d(daemon_args(config), dir / "d.out", dir / "d.err");
+  ASSERT_EQ(d.wait(60s), 0) << d.err();
+  std::this_thread::sleep_for(200ms);  // the last datagrams in flight
+  const auto all = poses.all();
+  ASSERT_GT(all.size(), 1500u) << d.err();
+  std::size_t bridged = 0;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const daemon::PoseMessage& m = all[i].m;
+    const double t = m.sample_time;
+    ASSERT_NEAR(t * 250.0, std::round(t * 250.0), 1e-6) << "pose " << i << " off the 250 Hz grid: " << t;
+    EXPECT_FALSE(t > g.long_from + 1e-9 && t < g.long_to - 1e-9) << "pose " << i << " inside the long gap: " << t;
+    EXPECT_TRUE(m.position.has_value()) << "pose " << i;
+    if (m.bridged()) {
+      ++bridged;
+      EXPECT_GT(t, g.short_from - 0.004) << "a bridged pose away from the short gap";
+      EXPECT_LT(t, g.short_to + 0.004) << "a bridged pose away from the short gap";
+    }
+  }
+  EXPECT_GE(bridged, 17u);
+  EXPECT_LE(bridged, 20u);
+  const auto counters = last_counters(d.err(), "gaps", 1);
+  ASSERT_TRUE(counters) << d.err();
+  EXPECT_EQ(counters->published, all.size()) << counters->line;
+  EXPECT_NE(counters->line.find(", bridged gaps 1 (samples 20), resampled " + std::to_string(all.size()) + ", lerp fallbacks 0"),
+            std::string::npos)
       << counters->line;
   EXPECT_NE(counters->line.find(", restarts 1,"), std::string::npos) << "only the long gap restarts the window: " << counters->line;
 }

@@ -197,6 +197,49 @@ TEST_F(PipelineAllocation, BridgingAndResamplingAllocateNothingOnTheRealtimeThre
   EXPECT_EQ(run.stats.published + run.stats.publish_dropped, run.stats.resampled);
 }
 
+// pose_interpolation = "matrix-lerp" with positions (the demo has them): one logarithm per
+// interval, an exponential per pose, and the separate fallback for a step of pi/2 or more (the
+// first sample after the first dropout is turned by half a turn), all without allocating.
+TEST_F(PipelineAllocation, MatrixLerpBridgingAndResamplingAllocateNothingOnTheRealtimeThreads) {
+  testing::ScratchDir dir("posefair-alloc-");
+  const std::string text = testing::slurp(kDemoCsv);
+  std::istringstream in(text);
+  std::string line, csv;
+  for (std::size_t row = 0; std::getline(in, line); ++row) {
+    if (row != 0 && (row - 1) % 500 >= 480) continue;  // rows 480..499 of every 500 lost
+    if (row == 501) {
+      // t,qw,qx,qy,qz,...: q times (0,1,0,0), a half turn about x, is (-qx, qw, qz, -qy).
+      std::vector<std::string> f;
+      std::stringstream fields(line);
+      for (std::string v; std::getline(fields, v, ',');) f.push_back(v);
+      auto negated = [](const std::string& v) { return v[0] == '-' ? v.substr(1) : "-" + v; };
+      const std::string w = f[1], x = f[2], y = f[3], z = f[4];
+      f[1] = negated(x);
+      f[2] = w;
+      f[3] = z;
+      f[4] = negated(y);
+      line.clear();
+      for (std::size_t i = 0; i < f.size(); ++i) line += (i ? "," : "") + f[i];
+    }
+    csv += line + "\n";
+  }
+  std::ofstream(dir / "gaps.csv") << csv;
+  const PipelineRun run = run_pipeline("type = \"replay\"\npath = \"" + (dir / "gaps.csv").string() +
+                                           "\"\ntiming = \"fast\"\n"
+                                           "[stream.spline]\npublish_rate_hz = 1000.0\nbridge_gap = 0.1\n"
+                                           "pose_interpolation = \"matrix-lerp\"\n",
+                                       "linear", "binary");
+  std::printf("%s; lerp fallbacks %llu\n", describe(run).c_str(), static_cast<unsigned long long>(run.stats.lerp_fallbacks));
+  SCOPED_TRACE(describe(run));
+  EXPECT_TRUE(run.ended) << "the replay did not end";
+  ASSERT_EQ(run.threads, 2) << "the engine and the publisher thread each claim a slot";
+  for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
+  EXPECT_EQ(run.stats.bridged_gaps, 3u);
+  EXPECT_TRUE(run.stats.matrix_lerp);
+  EXPECT_GE(run.stats.lerp_fallbacks, 1u) << "the half turn after the first dropout";
+  EXPECT_GT(run.stats.resampled, 6900u);
+}
+
 // The negative control: JSON lines allocate a string per pose on the publisher thread, so the
 // slots do count those threads' allocations. Which slot is which thread is not known: one of
 // them (the publisher's) allocated, the other (the engine's) still did not.

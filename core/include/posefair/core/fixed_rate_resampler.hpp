@@ -10,12 +10,18 @@
 // between faired poses (the window restarted after a gap) restarts the spline: no grid pose is
 // made across it. When a stream ends, its last grid poses (up to lookahead + 1 input intervals)
 // are not made: the spline there is not final. No allocation after construction.
+//
+// With PoseInterpolation::MatrixLerp a grid pose is Alexa's lerp of the two faired poses
+// around it (rigid_pose_lerp.hpp), prepared once per input interval: it is final when the
+// faired pose after it arrives, so the added delay is at most one input interval, and a
+// stream's grid poses up to its last faired pose are all made.
 #include <cstddef>
 #include <cstdint>
 #include <span>
 
 #include "posefair/core/pose_spline.hpp"
 #include "posefair/core/pose_spline_window.hpp"
+#include "posefair/core/rigid_pose_lerp.hpp"
 #include "posefair/core/sample.hpp"
 
 namespace posefair {
@@ -23,7 +29,8 @@ namespace posefair {
 struct FixedRateResamplerOptions {
   double rate_hz = 250.0;  // > 0
   double max_step = 0.25;  // s: a longer step between faired poses restarts; > 0
-  geometric_splines::PoseSplineOptions spline;
+  geometric_splines::PoseSplineOptions spline;  // for PoseInterpolation::Spline
+  PoseInterpolation interpolation = PoseInterpolation::Spline;
 };
 
 class FixedRateResampler {
@@ -37,16 +44,22 @@ class FixedRateResampler {
   std::size_t push(const FairedPose& pose, std::span<FairedPose> out);
   std::size_t max_outputs() const { return max_outputs_; }
   // The most input intervals a grid pose waits for (the added delay in intervals).
-  std::size_t delay_intervals() const { return spline_.lookahead() + 1; }
+  std::size_t delay_intervals() const {
+    return options_.interpolation == PoseInterpolation::MatrixLerp ? 1 : spline_.lookahead() + 1;
+  }
   std::uint64_t restarts() const { return restarts_; }
+  // MatrixLerp: input intervals lerp refused (a step of pi/2 or more), interpolated separately.
+  std::uint64_t lerp_fallbacks() const { return lerp_.fallbacks(); }
 
  private:
   static constexpr std::size_t kFlagSlots = 16;  // (time, flags) of the newest faired poses
 
   std::uint32_t flags_between(double t) const;
+  std::size_t push_lerp(const FairedPose& pose, std::span<FairedPose> out);
 
   FixedRateResamplerOptions options_;
   geometric_splines::PoseSplineWindow spline_;
+  RigidPoseLerp lerp_;
   std::size_t max_outputs_;
   bool have_last_ = false;
   double last_time_ = 0.0;

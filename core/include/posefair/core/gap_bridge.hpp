@@ -7,12 +7,16 @@
 // The spline's velocity at the first sample after the gap needs the sample after that, so that
 // sample is held until its successor arrives: a gap costs one input interval of extra delay,
 // once. Bridged samples carry kBridged. No allocation after construction.
+//
+// With PoseInterpolation::MatrixLerp the gap is filled with Alexa's lerp of the two samples
+// around it (rigid_pose_lerp.hpp) as soon as the sample after it arrives: nothing is held.
 #include <cstddef>
 #include <cstdint>
 #include <span>
 
 #include "posefair/core/pose_spline.hpp"
 #include "posefair/core/pose_spline_window.hpp"
+#include "posefair/core/rigid_pose_lerp.hpp"
 #include "posefair/core/sample.hpp"
 
 namespace posefair {
@@ -21,12 +25,14 @@ struct GapBridgeOptions {
   double max_gap = 0.2;             // s: the longest gap bridged; > 0
   std::size_t max_bridged = 256;    // samples per gap at most (a longer gap gets a coarser step); >= 1
   geometric_splines::PoseSplineOptions spline;
+  PoseInterpolation interpolation = PoseInterpolation::Spline;
 };
 
 struct GapBridgeCounters {
   std::uint64_t gaps = 0;      // gaps bridged
   std::uint64_t samples = 0;   // samples made on the spline
   std::uint64_t too_long = 0;  // gaps longer than max_gap, passed through
+  std::uint64_t lerp_fallbacks = 0;  // MatrixLerp: gaps lerp refused (a step of pi/2 or more), bridged separately
 };
 
 class GapBridge {
@@ -45,9 +51,11 @@ class GapBridge {
 
  private:
   std::size_t release(const Sample& current, std::span<Sample> out);
+  std::size_t lerp_across(const Sample& after, std::span<Sample> out);
 
   GapBridgeOptions options_;
   geometric_splines::PoseSplineWindow spline_;
+  RigidPoseLerp lerp_;
   GapBridgeCounters counters_;
   double last_time_ = 0.0;      // of the newest sample handed on or held
   double interval_ = 0.0;       // the stream's regular interval (last step that was not a gap); 0 = unknown

@@ -15,6 +15,7 @@
 
 #include "posefair/core/fairing_window.hpp"
 #include "posefair/core/pose_spline.hpp"
+#include "posefair/core/rigid_pose_lerp.hpp"
 #include "posefair/daemon/overflow_policy.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
@@ -129,6 +130,9 @@ struct SplineConfig {
   double publish_rate_hz = 0.0;  // > 0: publish on a fixed grid at this rate instead of every faired pose
   double bridge_gap = 0.0;       // s, > 0: fill input gaps up to this long on the spline
   geometric_splines::PoseSplineOptions spline;  // order, manifold, knot velocity estimate
+  // "spline" (the spline above, rotation and position separately) or "matrix-lerp" (Alexa's
+  // lerp of the 4x4 transform between the two neighbouring samples; refuses the spline's keys)
+  PoseInterpolation pose_interpolation = PoseInterpolation::Spline;
   bool resampling() const { return publish_rate_hz > 0.0; }
   bool bridging() const { return bridge_gap > 0.0; }
 };

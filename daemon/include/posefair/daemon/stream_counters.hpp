@@ -23,6 +23,7 @@ struct StreamCounters {
   std::atomic<std::uint64_t> bridged_gaps{0};     // input gaps filled on the spline ([stream.spline] bridge_gap)
   std::atomic<std::uint64_t> bridged_samples{0};  // samples made for them
   std::atomic<std::uint64_t> resampled{0};        // grid poses made ([stream.spline] publish_rate_hz)
+  std::atomic<std::uint64_t> lerp_fallbacks{0};   // intervals matrix-lerp refused (pi/2 or more), interpolated separately
   std::atomic<std::uint64_t> published{0};        // poses sent to at least one destination (or to none configured)
   std::atomic<std::uint64_t> send_failures{0};    // failed sends (one per destination)
   std::atomic<std::uint64_t> recorded{0};         // handed to the recorder's writer
@@ -40,6 +41,8 @@ struct StreamStats {
   HistogramSnapshot latency;
   bool bridging = false, resampling = false;  // [stream.spline] parts configured
   std::uint64_t bridged_gaps = 0, bridged_samples = 0, resampled = 0;
+  bool matrix_lerp = false;  // [stream.spline] pose_interpolation = "matrix-lerp"
+  std::uint64_t lerp_fallbacks = 0;
   std::optional<drivers::DeviceHealth> device;  // the device link, for drivers that have one
   // Poses lost on the way to subscribers: overflow of the engine's and the publisher's rings.
   std::uint64_t dropped() const { return ring_dropped + publish_dropped; }
