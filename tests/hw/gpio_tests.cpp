@@ -3,7 +3,8 @@
 //  1. Edge timestamps are the kernel's CLOCK_MONOTONIC, and samples pushed through the
 //     data-ready sink are paired by the rule (paired, missing, extra), counters as it says.
 //  2. A line held by another consumer: samples pass unpaired, logged once; released, it is taken.
-//  3. The output line toggles once per on_pose() (the sim's value follows).
+//  3. The output line toggles once per on_pose() (the sim's value follows), or on its own as a
+//     heartbeat.
 //  4. End to end: posefaird with a serial stream on a pseudo-terminal and [stream.gpio]; an edge
 //     per frame, the published poses carry the edge times, the output line toggles per
 //     published pose; the line held by the test at start is taken once released.
@@ -217,6 +218,27 @@ TEST(GpioOutput, TheLineTogglesOncePerPose) {
   EXPECT_EQ(out.counters().errors, 0u);
   out.stop();
   EXPECT_EQ(sim.consumer(3), "");
+}
+
+TEST(GpioOutput, AHeartbeatTogglesOnItsOwn) {
+  GpioSim sim(2, "pf-test-beat");
+  drivers::GpioOutputOptions o;
+  o.chip = sim.chip_name();
+  o.line.offset = 1;
+  o.mode = drivers::GpioOutputMode::Heartbeat;
+  o.heartbeat_hz = 20.0;
+  o.consumer = "posefair-test";
+  drivers::GpioOutputLine out(o);
+  out.start();
+  // The line is seen high and low on the chip, without a single pose.
+  bool high = false, low = false;
+  ASSERT_TRUE(wait_until([&] {
+    (sim.value(1) != 0 ? high : low) = true;
+    return high && low && out.counters().toggles >= 4;
+  }, 10s)) << "toggles " << out.counters().toggles;
+  out.stop();
+  EXPECT_EQ(out.counters().errors, 0u);
+  EXPECT_EQ(sim.consumer(1), "");
 }
 
 TEST(GpioDaemon, EdgesTimeTheStreamsPosesAndTheOutputTogglesPerPublishedPose) {
