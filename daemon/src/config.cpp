@@ -128,7 +128,9 @@ constexpr std::string_view kEngineKeys[] = {
     "window",   "lag",      "order",    "solver",    "iterations", "smoothing", "smoothing_r",
     "smoothing_t", "cutoff_hz", "rate_hz", "continuity", "lambda_r", "lambda_t", "variant",
     "epsilon_r", "epsilon_t", "bound",  "gap",       "unit_tolerance"};
-constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "overflow", "driver", "engine", "spline"};
+constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "overflow", "driver", "engine", "spline", "gpio"};
+constexpr std::string_view kGpioKeys[] = {"chip",          "data_ready_line", "edge",        "bias",        "tolerance_min",
+                                          "tolerance_max", "output_line",     "output_mode", "heartbeat_hz"};
 constexpr std::string_view kSplineKeys[] = {"publish_rate_hz", "bridge_gap", "order", "manifold", "velocity", "pose_interpolation"};
 constexpr std::string_view kReplayKeys[] = {"type",   "path",   "timing",     "speed",        "schedule",     "loop",
                                             "rounds", "format", "joint",      "csv_prefix",   "skip_missing", "source_stream"};
@@ -924,7 +926,77 @@ class Parser {
     if (const toml::node* n = t.get("engine")) local = parse_engine(table_of(*n, key("engine"), "[stream.engine]"), key("engine"));
     s.engine = build_engine(global, local ? &*local : nullptr, driver_rate, t, prefix, s.name);
     if (const toml::node* n = t.get("spline")) s.spline = parse_spline(table_of(*n, key("spline"), "[stream.spline]"), key("spline"));
+    if (const toml::node* n = t.get("gpio")) {
+      std::optional<Given<double>> rate = local && local->rate_hz ? local->rate_hz : driver_rate ? driver_rate : global.rate_hz;
+      s.gpio = parse_gpio(table_of(*n, key("gpio"), "[stream.gpio]"), key("gpio"), rate);
+    }
     return s;
+  }
+
+  // A GPIO line: an offset (integer) or a line name (string).
+  drivers::GpioLineRef get_gpio_line(const toml::node& n, const std::string& key) const {
+    drivers::GpioLineRef ref;
+    if (n.is_integer())
+      ref.offset = static_cast<unsigned>(get_int(n, key, 0, 65535));
+    else if (n.is_string())
+      ref.name = get_nonempty_string(n, key);
+    else
+      wrong_type(n, key, "a line offset (integer) or a line name (string)");
+    return ref;
+  }
+
+  // [stream.gpio]; `rate` is the stream's sample rate where known, for the pairing window.
+  GpioConfig parse_gpio(const toml::table& t, const std::string& prefix, const std::optional<Given<double>>& rate) const {
+    check_keys(t, prefix, kGpioKeys);
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    GpioConfig g;
+    g.chip = get_nonempty_string(require(t, "chip", prefix), key("chip"));
+    const toml::node* input = t.get("data_ready_line");
+    const toml::node* output = t.get("output_line");
+    if (input == nullptr && output == nullptr)
+      fail(t.source().begin, key("data_ready_line"), "missing required key: give data_ready_line, output_line or both");
+    if (input) g.data_ready = get_gpio_line(*input, key("data_ready_line"));
+    if (output) g.output = get_gpio_line(*output, key("output_line"));
+    if (g.data_ready && g.output && g.data_ready->offset == g.output->offset && g.data_ready->name == g.output->name)
+      fail(*output, key("output_line"), "is the data_ready_line too: a line is an input or an output");
+    // The input line's keys mean nothing without it, the output's nothing without an output.
+    for (std::string_view k : {"edge", "bias", "tolerance_min", "tolerance_max"})
+      if (const toml::node* n = t.get(k); n && !input) fail(*n, key(k), "needs data_ready_line");
+    for (std::string_view k : {"output_mode", "heartbeat_hz"})
+      if (const toml::node* n = t.get(k); n && !output) fail(*n, key(k), "needs output_line");
+    if (const toml::node* n = t.get("edge"))
+      g.edge = get_choice<drivers::GpioEdge>(*n, key("edge"), {{"rising", drivers::GpioEdge::Rising}, {"falling", drivers::GpioEdge::Falling}});
+    if (const toml::node* n = t.get("bias"))
+      g.bias = get_choice<drivers::GpioBias>(*n, key("bias"), {{"as-is", drivers::GpioBias::AsIs},
+                                                               {"pull-up", drivers::GpioBias::PullUp},
+                                                               {"pull-down", drivers::GpioBias::PullDown},
+                                                               {"disabled", drivers::GpioBias::Disabled}});
+    const FloatRange seconds{0.0, false, 10.0, false};
+    if (const toml::node* n = t.get("tolerance_min")) g.pairing.tolerance_min = get_float(*n, key("tolerance_min"), seconds);
+    const toml::node* max_node = t.get("tolerance_max");
+    if (max_node) g.pairing.tolerance_max = get_float(*max_node, key("tolerance_max"), seconds);
+    const std::string max_key = key(max_node ? "tolerance_max" : "tolerance_min");
+    const toml::source_position max_at = max_node ? max_node->source().begin : t.source().begin;
+    try {
+      (void)drivers::EdgePairer(g.pairing);  // the pairer judges its own window
+    } catch (const std::invalid_argument& e) {
+      fail(max_at, max_key, e.what());
+    }
+    if (input && rate) {
+      const double width = g.pairing.tolerance_max - g.pairing.tolerance_min;
+      if (width >= 1.0 / rate->value)
+        fail(max_at, key("tolerance_max"),
+             "the pairing window (tolerance_max - tolerance_min = " + number(width) + " s) must be narrower than the sample period 1/" +
+                 number(rate->value) + " Hz (rate from " + rate->where.key + ")");
+    }
+    if (const toml::node* n = t.get("output_mode"))
+      g.output_mode = get_choice<drivers::GpioOutputMode>(
+          *n, key("output_mode"), {{"per-pose", drivers::GpioOutputMode::PerPose}, {"heartbeat", drivers::GpioOutputMode::Heartbeat}});
+    if (const toml::node* n = t.get("heartbeat_hz")) {
+      if (g.output_mode != drivers::GpioOutputMode::Heartbeat) fail(*n, key("heartbeat_hz"), "needs output_mode = 'heartbeat'");
+      g.heartbeat_hz = get_float(*n, key("heartbeat_hz"), FloatRange{0.0, true, 10000.0, false});
+    }
+    return g;
   }
 
   SplineConfig parse_spline(const toml::table& t, const std::string& prefix) const {

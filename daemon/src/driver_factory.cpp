@@ -152,4 +152,36 @@ MadeDriver make_driver(const StreamConfig& stream) {
   throw std::logic_error("make_driver: unknown driver type");
 }
 
+MadeGpioLines make_gpio_lines(const StreamConfig& stream, drivers::SampleSink& next) {
+  MadeGpioLines made;
+  if (!stream.gpio) return made;
+  const GpioConfig& g = *stream.gpio;
+  try {
+    if (g.data_ready) {
+      drivers::GpioDataReadyOptions o;
+      o.chip = g.chip;
+      o.line = *g.data_ready;
+      o.edge = g.edge;
+      o.bias = g.bias;
+      o.pairing = g.pairing;
+      o.consumer = "posefaird:" + stream.name;
+      o.log = to_spdlog(stream.name);
+      made.data_ready = std::make_unique<drivers::GpioDataReadySink>(std::move(o), next);
+    }
+    if (g.output) {
+      drivers::GpioOutputOptions o;
+      o.chip = g.chip;
+      o.line = *g.output;
+      o.mode = g.output_mode;
+      o.heartbeat_hz = g.heartbeat_hz;
+      o.consumer = "posefaird:" + stream.name + ":out";
+      o.log = to_spdlog(stream.name);
+      made.output = std::make_unique<drivers::GpioOutputLine>(std::move(o));
+    }
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("stream '" + stream.name + "': " + e.what());
+  }
+  return made;
+}
+
 }  // namespace posefair::daemon

@@ -102,6 +102,7 @@ struct Pipeline::Stream final : drivers::SampleSink {
   std::optional<FixedRateResampler> resampler;  // engine thread only; [stream.spline] publish_rate_hz
   std::vector<FairedPose> grid;                 // engine scratch
   StreamCounters counters;
+  MadeGpioLines gpio;                           // [stream.gpio]: data-ready sink (driver thread), output line
   std::atomic<bool> driver_running{false};
   std::atomic<bool> driver_done{false};
   bool flushed = false;                         // engine thread only
@@ -118,6 +119,7 @@ Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
     for (std::string& w : made.warnings) warnings_.push_back("stream '" + sc.name + "': " + w);
     header_.streams.push_back(drivers::StreamInfo{sc.id, sc.name, made.source});
     streams_.push_back(std::make_unique<Stream>(*this, sc, std::move(made), static_cast<std::uint32_t>(i), record));
+    streams_.back()->gpio = make_gpio_lines(sc, *streams_.back());
     ids.push_back(sc.id);
   }
   publisher_ = std::make_unique<Publisher>(session, ids, config_.outputs, first_sequence);
@@ -165,6 +167,8 @@ std::vector<std::string> Pipeline::start() {
     }
   }
   if (config_.recorder.enabled) recorder_thread_ = std::thread([this] { recorder_loop(); });
+  for (auto& sp : streams_)
+    if (sp->gpio.output) sp->gpio.output->start();
   drivers_running_.store(static_cast<int>(streams_.size()), std::memory_order_release);
   for (auto& sp : streams_) {
     Stream* s = sp.get();
@@ -172,7 +176,9 @@ std::vector<std::string> Pipeline::start() {
     driver_threads_.emplace_back([this, s](std::stop_token stop) {
       // "pf-d-<stream>", cut to the 15 characters Linux keeps.
       ::pthread_setname_np(::pthread_self(), ("pf-d-" + s->config.name).substr(0, 15).c_str());
-      s->driver->run(stop, *s);
+      // With a data-ready line the driver pushes into it, and it into the stream.
+      s->driver->run(stop, s->gpio.data_ready ? static_cast<drivers::SampleSink&>(*s->gpio.data_ready) : *s);
+      if (s->gpio.data_ready) s->gpio.data_ready->release();
       s->driver_running.store(false, std::memory_order_release);
       s->driver_done.store(true, std::memory_order_release);
       drivers_running_.fetch_sub(1, std::memory_order_acq_rel);
@@ -201,6 +207,8 @@ void Pipeline::stop(bool keep_recorder) {
   publisher_stop_.store(true, std::memory_order_release);
   wake_publisher();
   publisher_thread_.join();
+  for (auto& sp : streams_)
+    if (sp->gpio.output) sp->gpio.output->stop();  // the line is free for the next pipeline
   if (recorder_thread_.joinable()) {
     recorder_stop_.store(true, std::memory_order_release);
     recorder_thread_.join();
@@ -315,6 +323,7 @@ void Pipeline::publisher_loop() {
         const Publisher::Result res = publisher_->publish(p);
         const std::uint64_t done = monotonic_ns();
         s.counters.published.fetch_add(1, std::memory_order_relaxed);
+        if (s.gpio.output) s.gpio.output->on_pose();  // the scope's edge: this pose has been sent
         if (res.failures) s.counters.send_failures.fetch_add(res.failures, std::memory_order_relaxed);
         s.counters.latency.record(done - p.enqueued_ns);
       }
@@ -374,6 +383,8 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.record_dropped = s.record_ring ? s.record_ring->dropped() : 0;
     st.latency = s.counters.latency.snapshot();
     st.device = s.driver->health();
+    if (s.gpio.data_ready) st.data_ready = s.gpio.data_ready->counters();
+    if (s.gpio.output) st.gpio_output = s.gpio.output->counters();
     st.bridging = s.config.spline.bridging();
     st.resampling = s.config.spline.resampling();
     st.bridged_gaps = get(s.counters.bridged_gaps);

@@ -32,6 +32,29 @@ std::string device_text(const drivers::DeviceHealth& d) {
   return buf;
 }
 
+// "; gpio data-ready held, edges 300, paired 298, missing 2, extra 1, late 0, overflow 0,
+//  request failures 0, losses 0; gpio output held, toggles 298, errors 0"
+std::string gpio_text(const std::optional<drivers::GpioDataReadyCounters>& in,
+                      const std::optional<drivers::GpioOutputCounters>& out) {
+  std::string text;
+  char buf[320];
+  if (in) {
+    const drivers::EdgePairingCounters& p = in->pairing;
+    std::snprintf(buf, sizeof buf,
+                  "; gpio data-ready %s, edges %" PRIu64 ", paired %" PRIu64 ", missing %" PRIu64 ", extra %" PRIu64
+                  ", late %" PRIu64 ", overflow %" PRIu64 ", request failures %" PRIu64 ", losses %" PRIu64,
+                  in->line_held ? "held" : "NOT HELD", p.edges, p.paired, p.missing, p.extra_edges, p.late_edges, p.overflow,
+                  in->request_failures, in->losses);
+    text += buf;
+  }
+  if (out) {
+    std::snprintf(buf, sizeof buf, "; gpio output %s, toggles %" PRIu64 ", errors %" PRIu64,
+                  out->line_held ? "held" : "NOT HELD", out->toggles, out->errors);
+    text += buf;
+  }
+  return text;
+}
+
 }  // namespace
 
 std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, const std::vector<StreamStats>& previous,
@@ -66,6 +89,7 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
       lines.back() += buf;
     }
     if (s.device) lines.back() += device_text(*s.device);
+    lines.back() += gpio_text(s.data_ready, s.gpio_output);
   }
   return lines;
 }
@@ -84,6 +108,12 @@ std::string status_line(const std::vector<StreamStats>& now, const std::vector<S
     if (s.device) {
       std::snprintf(buf, sizeof buf, "%s outages %" PRIu64 " bad %" PRIu64, s.device->connected ? "" : " DISCONNECTED",
                     s.device->outages, s.device->bad_frames);
+      out += buf;
+    }
+    // A data-ready line that is not held means unpaired (receive-timed) samples.
+    if (s.data_ready) {
+      std::snprintf(buf, sizeof buf, "%s missing %" PRIu64, s.data_ready->line_held ? " gpio" : " GPIO-LINE-NOT-HELD",
+                    s.data_ready->pairing.missing);
       out += buf;
     }
   }

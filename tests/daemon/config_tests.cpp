@@ -536,6 +536,62 @@ spline = { publish_rate_hz = 90.0, bridge_gap = 0.1, pose_interpolation = "matri
   EXPECT_TRUE(c.streams[2].spline.bridging());
 }
 
+TEST(Config, TheGpioTableSetsTheDataReadyAndOutputLines) {
+  const DaemonConfig c = parse_config(R"toml(
+[[stream]]
+id = 1
+name = "plain"
+driver = { type = "synthetic" }
+
+[[stream]]
+id = 2
+name = "imu"
+driver = { type = "synthetic", rate_hz = 200.0 }
+[stream.gpio]
+chip = "gpio-sim.0-node0"
+data_ready_line = 17
+edge = "falling"
+bias = "pull-up"
+tolerance_min = 0.0005
+tolerance_max = 0.004
+output_line = "SCOPE"
+output_mode = "heartbeat"
+heartbeat_hz = 50
+
+[[stream]]
+id = 3
+name = "out-only"
+driver = { type = "synthetic" }
+gpio = { chip = "/dev/gpiochip1", output_line = 2 }
+)toml",
+                                      "gpio.toml");
+  ASSERT_EQ(c.streams.size(), 3u);
+  EXPECT_FALSE(c.streams[0].gpio.has_value());
+  ASSERT_TRUE(c.streams[1].gpio.has_value());
+  const GpioConfig& g = *c.streams[1].gpio;
+  EXPECT_EQ(g.chip, "gpio-sim.0-node0");
+  ASSERT_TRUE(g.data_ready.has_value());
+  EXPECT_EQ(g.data_ready->offset, 17u);
+  EXPECT_EQ(g.edge, drivers::GpioEdge::Falling);
+  EXPECT_EQ(g.bias, drivers::GpioBias::PullUp);
+  EXPECT_EQ(g.pairing.tolerance_min, 0.0005);
+  EXPECT_EQ(g.pairing.tolerance_max, 0.004);
+  ASSERT_TRUE(g.output.has_value());
+  EXPECT_FALSE(g.output->offset.has_value());
+  EXPECT_EQ(g.output->name, "SCOPE");
+  EXPECT_EQ(g.output_mode, drivers::GpioOutputMode::Heartbeat);
+  EXPECT_EQ(g.heartbeat_hz, 50.0);
+  ASSERT_TRUE(c.streams[2].gpio.has_value());
+  const GpioConfig& o = *c.streams[2].gpio;
+  EXPECT_FALSE(o.data_ready.has_value());
+  EXPECT_EQ(o.output->offset, 2u);
+  EXPECT_EQ(o.output_mode, drivers::GpioOutputMode::PerPose);
+  // Defaults of the input line: rising edge, bias as it is, the pairer's window.
+  EXPECT_EQ(o.edge, drivers::GpioEdge::Rising);
+  EXPECT_EQ(o.bias, drivers::GpioBias::AsIs);
+  EXPECT_EQ(o.pairing.tolerance_max, drivers::EdgePairingOptions{}.tolerance_max);
+}
+
 TEST(Config, TheMostSpecificTableDecidesTheSmoothing) {
   testing::ScratchDir dir("posefair-config-");
   write_file(dir / "poses.csv", "t,qw,qx,qy,qz\n0,1,0,0,0\n");
@@ -1257,6 +1313,129 @@ name = "a"
 driver = { type = "synthetic" }
 spline = { bridge_gap = 0.1, pose_interpolation = "matrix-lerp", velocity = "central" }
 )", "stream[1].spline.velocity: has no meaning with pose_interpolation = 'matrix-lerp'", 5},
+    {"gpio: no chip", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.gpio]
+data_ready_line = 17
+)", "stream[1].gpio.chip: missing required key", 5},
+    {"gpio: no line at all", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.gpio]
+chip = "gpiochip0"
+)", "stream[1].gpio.data_ready_line: missing required key: give data_ready_line, output_line or both", 5},
+    {"gpio: a line that is neither offset nor name", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.gpio]
+chip = "gpiochip0"
+data_ready_line = 1.5
+)", "stream[1].gpio.data_ready_line: expected a line offset (integer) or a line name (string), got a float", 7},
+    {"gpio: unknown edge", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.gpio]
+chip = "gpiochip0"
+data_ready_line = 3
+edge = "raising"
+)", "stream[1].gpio.edge: expected one of 'rising', 'falling', got 'raising' (did you mean 'rising'?)", 8},
+    {"gpio: unknown bias", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.gpio]
+chip = "gpiochip0"
+data_ready_line = 3
+bias = "pullup"
+)", "stream[1].gpio.bias: expected one of 'as-is', 'pull-up', 'pull-down', 'disabled', got 'pullup'", 8},
+    {"gpio: tolerance_max below tolerance_min", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.gpio]
+chip = "gpiochip0"
+data_ready_line = 3
+tolerance_min = 0.004
+tolerance_max = 0.002
+)", "stream[1].gpio.tolerance_max: GPIO edge pairing: need 0 <= tolerance_min <= tolerance_max", 9},
+    {"gpio: negative tolerance", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.gpio]
+chip = "gpiochip0"
+data_ready_line = 3
+tolerance_min = -0.001
+)", "stream[1].gpio.tolerance_min: out of range: must be in [0, 10]", 8},
+    {"gpio: window wider than the sample period", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 400.0 }
+[stream.gpio]
+chip = "gpiochip0"
+data_ready_line = 3
+tolerance_max = 0.003
+)", "stream[1].gpio.tolerance_max: the pairing window (tolerance_max - tolerance_min = 0.003 s) must be narrower than the sample period 1/400 Hz (rate from stream[1].driver.rate_hz)", 8},
+    {"gpio: the same line in and out", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.gpio]
+chip = "gpiochip0"
+data_ready_line = "DRDY"
+output_line = "DRDY"
+)", "stream[1].gpio.output_line: is the data_ready_line too", 8},
+    {"gpio: heartbeat rate without heartbeat mode", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.gpio]
+chip = "gpiochip0"
+output_line = 4
+heartbeat_hz = 10.0
+)", "stream[1].gpio.heartbeat_hz: needs output_mode = 'heartbeat'", 8},
+    {"gpio: heartbeat rate of zero", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.gpio]
+chip = "gpiochip0"
+output_line = 4
+output_mode = "heartbeat"
+heartbeat_hz = 0
+)", "stream[1].gpio.heartbeat_hz: out of range: must be in (0, 10000], got 0", 9},
+    {"gpio: output mode without an output line", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.gpio]
+chip = "gpiochip0"
+data_ready_line = 3
+output_mode = "per-pose"
+)", "stream[1].gpio.output_mode: needs output_line", 8},
+    {"gpio: edge without a data-ready line", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.gpio]
+chip = "gpiochip0"
+output_line = 4
+edge = "falling"
+)", "stream[1].gpio.edge: needs data_ready_line", 8},
+    {"gpio: unknown key", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.gpio]
+chip = "gpiochip0"
+data_ready_line = 3
+toleranse_max = 0.002
+)", "stream[1].gpio.toleranse_max: unknown key (did you mean 'tolerance_max'?)", 8},
     {"a table that is not one", R"(daemon = 5
 [[stream]]
 id = 1

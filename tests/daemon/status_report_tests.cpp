@@ -70,5 +70,32 @@ TEST(StatusReport, StatusLineMarksADisconnectedDevice) {
   EXPECT_EQ(status_line({head}, {prev_head}, 2.0), "head 500.0/s drop 0 p99 0us outages 2 bad 4");
 }
 
+TEST(StatusReport, GpioLinesAddTheirCountersAndALineNotHeldShows) {
+  StreamStats s = stream(1, "head", 2000);
+  drivers::GpioDataReadyCounters in;
+  in.line_held = true;
+  in.pairing.edges = 300;
+  in.pairing.paired = 298;
+  in.pairing.missing = 2;
+  in.pairing.extra_edges = 1;
+  in.pairing.late_edges = 3;
+  in.pairing.overflow = 4;
+  in.request_failures = 5;
+  in.losses = 6;
+  s.data_ready = in;
+  s.gpio_output = drivers::GpioOutputCounters{true, 298, 0};
+  const auto lines = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(lines[0].find("; gpio data-ready held, edges 300, paired 298, missing 2, extra 1, late 3, overflow 4, "
+                          "request failures 5, losses 6; gpio output held, toggles 298, errors 0"),
+            std::string::npos)
+      << lines[0];
+  EXPECT_EQ(status_line({s}, {stream(1, "head", 1000)}, 2.0), "head 500.0/s drop 0 p99 0us gpio missing 2");
+  s.data_ready->line_held = false;
+  s.gpio_output->line_held = false;
+  EXPECT_NE(counter_lines({s}, {}, 0.0)[0].find("; gpio data-ready NOT HELD, edges 300"), std::string::npos);
+  EXPECT_NE(counter_lines({s}, {}, 0.0)[0].find("; gpio output NOT HELD, toggles 298"), std::string::npos);
+  EXPECT_EQ(status_line({s}, {stream(1, "head", 1000)}, 2.0), "head 500.0/s drop 0 p99 0us GPIO-LINE-NOT-HELD missing 2");
+}
+
 }  // namespace
 }  // namespace posefair::daemon

@@ -21,6 +21,8 @@
 #include "posefair/daemon/wire_protocol.hpp"
 #include "posefair/drivers/decoder.hpp"
 #include "posefair/drivers/hidraw_driver.hpp"
+#include "posefair/drivers/gpio_data_ready.hpp"
+#include "posefair/drivers/gpio_output_line.hpp"
 #include "posefair/drivers/replay_driver.hpp"
 #include "posefair/drivers/serial_port.hpp"
 #include "posefair/drivers/time_base.hpp"
@@ -137,6 +139,19 @@ struct SplineConfig {
   bool bridging() const { return bridge_gap > 0.0; }
 };
 
+// [stream.gpio]: a data-ready input line whose edges time the stream's samples, and/or an
+// output line toggled per published pose or as a heartbeat (docs/hid-gpio.md, "GPIO").
+struct GpioConfig {
+  std::string chip;                                // "gpiochip0", a path or a label
+  std::optional<drivers::GpioLineRef> data_ready;  // data_ready_line
+  drivers::GpioEdge edge = drivers::GpioEdge::Rising;
+  drivers::GpioBias bias = drivers::GpioBias::AsIs;
+  drivers::EdgePairingOptions pairing;             // tolerance_min, tolerance_max
+  std::optional<drivers::GpioLineRef> output;      // output_line
+  drivers::GpioOutputMode output_mode = drivers::GpioOutputMode::PerPose;
+  double heartbeat_hz = 1.0;
+};
+
 struct StreamConfig {
   std::uint32_t id = 0;           // unique; the wire protocol's stream id
   std::string name;               // unique, non-empty; for logs, STATUS= and the recording's stream table
@@ -148,6 +163,7 @@ struct StreamConfig {
   // half the rotation angle given in the file; smoothing from cutoff_hz when that was given).
   WindowConfig engine;
   SplineConfig spline;
+  std::optional<GpioConfig> gpio;
 };
 
 struct OutputConfig {

@@ -10,6 +10,8 @@
 
 #include "posefair/daemon/latency_histogram.hpp"
 #include "posefair/drivers/driver.hpp"
+#include "posefair/drivers/gpio_data_ready.hpp"
+#include "posefair/drivers/gpio_output_line.hpp"
 
 namespace posefair::daemon {
 
@@ -44,6 +46,8 @@ struct StreamStats {
   bool matrix_lerp = false;  // [stream.spline] pose_interpolation = "matrix-lerp"
   std::uint64_t lerp_fallbacks = 0;
   std::optional<drivers::DeviceHealth> device;  // the device link, for drivers that have one
+  std::optional<drivers::GpioDataReadyCounters> data_ready;  // [stream.gpio] data_ready_line
+  std::optional<drivers::GpioOutputCounters> gpio_output;    // [stream.gpio] output_line
   // Poses lost on the way to subscribers: overflow of the engine's and the publisher's rings.
   std::uint64_t dropped() const { return ring_dropped + publish_dropped; }
 };
