@@ -528,11 +528,12 @@ TEST(SocketCanDaemon, CansendCanplayerAndPythonCanFramesArePublishedAsPoses) {
         << "stream " << s << " pose " << k;
     times[s][static_cast<std::size_t>(k)] = g.m.sample_time;
   }
-  // time_source = "device": the sample times are spaced as the device clocks were (10 ms),
-  // not as the peers' frames happened to arrive.
+  // time_source = "device": the sample times are spaced as the device clocks were (10 ms,
+  // within the time base's ±2 % slew, time_base.hpp step 7), not as the peers' frames happened
+  // to arrive (canplayer: 3 ms per sample; python-can and cansend: as fast as they run).
   for (int s = 1; s <= 3; ++s)
     for (int k = 1; k < kPeerSamples; ++k)
-      EXPECT_NEAR(times[s][k] - times[s][k - 1], 0.01, 1e-6) << "stream " << s << " pose " << k;
+      EXPECT_NEAR(times[s][k] - times[s][k - 1], 0.01, 0.01 * 0.02 + 1e-6) << "stream " << s << " pose " << k;
   EXPECT_EQ(seen[1], kPeerSamples);
   EXPECT_EQ(seen[2], kPeerSamples);
   EXPECT_EQ(seen[3], kPeerSamples);
