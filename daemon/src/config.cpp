@@ -20,6 +20,7 @@
 
 #include "posefair/core/sample_gate.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
+#include "posefair/drivers/can_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
 #include "posefair/drivers/pose_file.hpp"
 
@@ -133,7 +134,12 @@ constexpr std::string_view kGpioKeys[] = {"chip",          "data_ready_line", "e
                                           "tolerance_max", "output_line",     "output_mode", "heartbeat_hz"};
 constexpr std::string_view kSplineKeys[] = {"publish_rate_hz", "bridge_gap", "order", "manifold", "velocity", "pose_interpolation"};
 constexpr std::string_view kReplayKeys[] = {"type",   "path",   "timing",     "speed",        "schedule",     "loop",
-                                            "rounds", "format", "joint",      "csv_prefix",   "skip_missing", "source_stream"};
+                                            "rounds", "format", "joint",      "csv_prefix",   "skip_missing", "source_stream",
+                                            // a candump log (docs/can-devices.md)
+                                            "candump", "interface", "protocol", "time_source", "posefair_base_id",
+                                            "posefair_id_format", "xsens_quaternion_id", "xsens_sample_time_id",
+                                            "xsens_group_counter_id", "xsens_id_format", "xsens_sample_time_unit",
+                                            "dronecan_node_id"};
 constexpr std::string_view kSyntheticKeys[] = {"type", "rate_hz", "duration", "rotation_noise", "with_position", "seed", "phase"};
 constexpr std::string_view kSerialKeys[] = {"type",         "device",   "usb",           "serial_number",
                                             "baud",         "data_bits", "parity",       "stop_bits",
@@ -162,6 +168,29 @@ const ProtocolOption kProtocolOptions[] = {
     {"yost_data_length", "yost", &drivers::DecoderOptions::yost_data_length},
 };
 
+constexpr std::string_view kSocketCanKeys[] = {"type", "interface", "protocol", "fd", "time_source", "reconnect_min",
+                                               "reconnect_max", "posefair_base_id", "posefair_id_format",
+                                               "xsens_quaternion_id", "xsens_sample_time_id", "xsens_group_counter_id",
+                                               "xsens_id_format", "xsens_sample_time_unit", "dronecan_node_id"};
+
+// CAN decoder options (drivers::CanDecoderOptions), each valid with one CAN protocol only; the
+// decoder judges the value (make_can_decoder throws std::invalid_argument for a bad one).
+struct CanProtocolOption {
+  std::string_view key;
+  std::string_view protocol;
+  std::string drivers::CanDecoderOptions::*field;
+};
+const CanProtocolOption kCanProtocolOptions[] = {
+    {"posefair_base_id", "posefair-can", &drivers::CanDecoderOptions::posefair_base_id},
+    {"posefair_id_format", "posefair-can", &drivers::CanDecoderOptions::posefair_id_format},
+    {"xsens_quaternion_id", "xsens-can", &drivers::CanDecoderOptions::xsens_quaternion_id},
+    {"xsens_sample_time_id", "xsens-can", &drivers::CanDecoderOptions::xsens_sample_time_id},
+    {"xsens_group_counter_id", "xsens-can", &drivers::CanDecoderOptions::xsens_group_counter_id},
+    {"xsens_id_format", "xsens-can", &drivers::CanDecoderOptions::xsens_id_format},
+    {"xsens_sample_time_unit", "xsens-can", &drivers::CanDecoderOptions::xsens_sample_time_unit},
+    {"dronecan_node_id", "dronecan-ahrs", &drivers::CanDecoderOptions::dronecan_node_id},
+};
+
 // Each [stream.driver] type and its keys.
 struct DriverKind {
   DriverType type;
@@ -172,6 +201,7 @@ const DriverKind kDriverKinds[] = {
     {DriverType::Replay, "replay", kReplayKeys},
     {DriverType::Synthetic, "synthetic", kSyntheticKeys},
     {DriverType::Serial, "serial", kSerialKeys},
+    {DriverType::SocketCan, "socketcan", kSocketCanKeys},
     {DriverType::Hid, "hid", kHidKeys},
 };
 constexpr std::string_view kOutputKeys[] = {"encoding", "destinations", "ttl",          "interface",
@@ -688,6 +718,105 @@ class Parser {
     }
   }
 
+  // The CAN keys a live SocketCAN source and a candump replay share: protocol (required), its
+  // decoder options, time_source. The protocol is checked last, as for serial.
+  void parse_can_decoder(const toml::table& t, const std::string& prefix, SocketCanSourceConfig& c) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    const toml::node& protocol_node = require(t, "protocol", prefix);
+    c.protocol = get_nonempty_string(protocol_node, key("protocol"));
+    const toml::node* option_node = nullptr;  // the first decoder option given, for errors
+    std::string option_key;
+    for (const CanProtocolOption& po : kCanProtocolOptions) {
+      const toml::node* n = t.get(po.key);
+      if (n == nullptr) continue;
+      if (c.protocol != po.protocol)
+        fail(*n, key(po.key), "only for protocol " + in_quotes(po.protocol) + " (this source's protocol is " +
+                                  in_quotes(c.protocol) + ")");
+      // Numbers are welcome for identifiers (posefair_base_id = 0x204, dronecan_node_id = 42).
+      c.decoder.*po.field = n->is_integer() ? std::to_string(n->as_integer()->get()) : get_nonempty_string(*n, key(po.key));
+      if (option_node == nullptr) {
+        option_node = n;
+        option_key = key(po.key);
+      }
+    }
+    if (const toml::node* n = t.get("time_source"))
+      c.time_source = get_choice<drivers::TimeSource>(*n, key("time_source"),
+                                                      {{"auto", drivers::TimeSource::Auto},
+                                                       {"receive", drivers::TimeSource::Receive},
+                                                       {"device", drivers::TimeSource::Device}});
+    const std::vector<std::string> known = drivers::can_decoder_protocols();
+    if (std::find(known.begin(), known.end(), c.protocol) == known.end()) {
+      std::string list;
+      for (const std::string& p : known) list += (list.empty() ? "" : ", ") + p;
+      const std::vector<std::string_view> names(known.begin(), known.end());
+      fail(protocol_node, key("protocol"),
+           "unknown CAN protocol " + in_quotes(c.protocol) + " (known: " + (list.empty() ? "none" : list) + ")" +
+               suggestion(c.protocol, names));
+    }
+    try {
+      (void)drivers::make_can_decoder(c.protocol, c.decoder);  // the decoder judges its own options
+    } catch (const std::invalid_argument& e) {
+      if (option_node != nullptr) fail(*option_node, option_key, e.what());
+      fail(protocol_node, key("protocol"), e.what());
+    }
+  }
+
+  // A network interface name as the kernel takes it: 1..15 characters, no '/', no blanks.
+  std::string get_interface(const toml::node& n, const std::string& key) const {
+    const std::string name = get_nonempty_string(n, key);
+    if (name.size() > 15) fail(n, key, "an interface name has at most 15 characters, got " + in_quotes(name));
+    if (name.find_first_of("/: \t") != std::string::npos || name == "." || name == "..")
+      fail(n, key, "not an interface name: " + in_quotes(name));
+    return name;
+  }
+
+  // [stream.driver] with type = "socketcan". The interface is not opened (nor required to
+  // exist): the driver waits for it.
+  void parse_socketcan(const toml::table& t, const std::string& prefix, SocketCanSourceConfig& c) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    c.interface = get_interface(require(t, "interface", prefix), key("interface"));
+    if (const toml::node* n = t.get("fd")) c.fd = get_bool(*n, key("fd"));
+    const toml::node* min_node = t.get("reconnect_min");
+    const toml::node* max_node = t.get("reconnect_max");
+    if (min_node != nullptr) c.reconnect_min = get_float(*min_node, key("reconnect_min"), FloatRange{0.0, true, 60.0, false});
+    if (max_node != nullptr) c.reconnect_max = get_float(*max_node, key("reconnect_max"), FloatRange{0.0, true, 3600.0, false});
+    if (c.reconnect_max < c.reconnect_min) {
+      if (max_node != nullptr)
+        fail(*max_node, key("reconnect_max"), "must be >= reconnect_min (" + number(c.reconnect_min) + " s), got " + number(c.reconnect_max));
+      fail(*min_node, key("reconnect_min"), "must be <= reconnect_max (" + number(c.reconnect_max) + " s, the default), got " + number(c.reconnect_min));
+    }
+    parse_can_decoder(t, prefix, c);
+  }
+
+  // [stream.driver] with type = "replay" and key candump: a candump log decoded by a CAN
+  // protocol decoder (the driver factory decodes it). Timing keys as for any replay.
+  void parse_candump_replay(const toml::table& t, const std::string& prefix, StreamConfig& s) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    ReplaySourceConfig& r = s.driver.replay;
+    const toml::node& log_node = *t.get("candump");
+    for (std::string_view other : {"path", "format", "joint", "csv_prefix", "skip_missing", "source_stream"})
+      if (const toml::node* n = t.get(other))
+        fail(*n, key(other), "not for a candump log (candump is set at line " + std::to_string(log_node.source().begin.line) + ")");
+    r.candump = resolve(get_nonempty_string(log_node, key("candump")));
+    std::error_code ec;
+    const auto status = std::filesystem::status(r.candump, ec);
+    if (!std::filesystem::exists(status)) fail(log_node, key("candump"), "no such file: " + r.candump.string());
+    if (!std::filesystem::is_regular_file(status)) fail(log_node, key("candump"), "not a regular file: " + r.candump.string());
+    if (const toml::node* n = t.get("interface")) r.can.interface = get_interface(*n, key("interface"));
+    drivers::ReplayOptions& o = r.options;
+    o.stream_id = s.id;
+    if (const toml::node* n = t.get("timing"))
+      o.timing = get_choice<drivers::ReplayTiming>(*n, key("timing"), {{"original", drivers::ReplayTiming::Original},
+                                                                       {"fast", drivers::ReplayTiming::AsFastAsPossible}});
+    if (const toml::node* n = t.get("speed")) o.speed = get_float(*n, key("speed"), kPositive);
+    if (const toml::node* n = t.get("schedule"))
+      o.schedule = get_choice<drivers::ReplaySchedule>(*n, key("schedule"), {{"time", drivers::ReplaySchedule::Time},
+                                                                             {"receive-time", drivers::ReplaySchedule::ReceiveTime}});
+    if (const toml::node* n = t.get("loop")) o.loop = get_bool(*n, key("loop"));
+    if (const toml::node* n = t.get("rounds")) o.max_rounds = static_cast<std::uint64_t>(get_int(*n, key("rounds"), 0, kMaxI64));
+    parse_can_decoder(t, prefix, r.can);
+  }
+
   // [stream.driver] with type = "hid" (docs/hid-gpio.md). The device is not opened (nor
   // required to exist): the driver waits for it, and hid-sensor reads its layout from it.
   void parse_hid(const toml::table& t, const std::string& prefix, HidSourceConfig& c) const {
@@ -820,7 +949,7 @@ class Parser {
     s.driver.type = get_choice<DriverType>(
         type_node, type_key,
         {{"replay", DriverType::Replay}, {"synthetic", DriverType::Synthetic}, {"serial", DriverType::Serial},
-         {"hid", DriverType::Hid}});
+         {"socketcan", DriverType::SocketCan}, {"hid", DriverType::Hid}});
     const DriverKind* own = &kDriverKinds[0];
     for (const DriverKind& k : kDriverKinds)
       if (k.type == s.driver.type) own = &k;
@@ -846,11 +975,23 @@ class Parser {
       parse_hid(t, prefix, s.driver.hid);
       return std::nullopt;
     }
+    if (s.driver.type == DriverType::SocketCan) {
+      parse_socketcan(t, prefix, s.driver.socketcan);
+      return std::nullopt;
+    }
     const bool replay = s.driver.type == DriverType::Replay;
     auto key = [&](std::string_view name) { return join_key(prefix, name); };
 
+    if (replay && t.get("candump") != nullptr) {
+      parse_candump_replay(t, prefix, s);
+      return std::nullopt;
+    }
     if (replay) {
       ReplaySourceConfig& r = s.driver.replay;
+      for (std::string_view can_key : {"interface", "protocol", "time_source"})
+        if (const toml::node* n = t.get(can_key)) fail(*n, key(can_key), "only for a candump log (key candump)");
+      for (const CanProtocolOption& po : kCanProtocolOptions)
+        if (const toml::node* n = t.get(po.key)) fail(*n, key(po.key), "only for a candump log (key candump)");
       const toml::node& path_node = require(t, "path", prefix);
       r.path = resolve(get_nonempty_string(path_node, key("path")));
       std::error_code ec;

@@ -5,16 +5,57 @@
 #include <stdexcept>
 #include <utility>
 
+#include "posefair/drivers/candump_replay.hpp"
 #include "posefair/drivers/hidraw_driver.hpp"
 #include "posefair/drivers/replay_driver.hpp"
 #include "posefair/drivers/serial_driver.hpp"
+#include "posefair/drivers/socketcan_driver.hpp"
 #include "posefair/drivers/synthetic_driver.hpp"
 
 namespace posefair::daemon {
 namespace {
 
+// A candump log decoded into samples up front (candump_replay.hpp), then played like any
+// replay. Malformed lines are skipped and reported as warnings (the first few by line number).
+MadeDriver make_candump_replay(const StreamConfig& stream) {
+  const ReplaySourceConfig& rc = stream.driver.replay;
+  drivers::ReplayOptions options = rc.options;
+  options.stream_id = stream.id;
+  const std::string where = "stream '" + stream.name + "': candump " + rc.candump.string() + ": ";
+  drivers::CandumpReplayOptions co;
+  co.protocol = rc.can.protocol;
+  co.decoder = rc.can.decoder;
+  co.interface = rc.can.interface;
+  co.stream_id = stream.id;
+  co.time_source = rc.can.time_source;
+  MadeDriver made;
+  made.source = "replay:" + rc.candump.string() + " (" + rc.can.protocol + ")";
+  try {
+    drivers::CandumpReplay decoded = drivers::decode_candump_file(rc.candump, co);
+    constexpr std::size_t kShown = 5;
+    const std::string file = "candump " + rc.candump.string() + ": ";  // the pipeline adds the stream
+    for (std::size_t i = 0; i < decoded.problems.size() && i < kShown; ++i)
+      made.warnings.push_back(file + "line " + std::to_string(decoded.problems[i].line) + ": " +
+                              decoded.problems[i].message + " (skipped)");
+    if (decoded.problems.size() > kShown)
+      made.warnings.push_back(file + std::to_string(decoded.problems.size() - kShown) + " more malformed lines skipped");
+    if (decoded.samples.empty())
+      throw std::runtime_error(where + "no samples decoded (" + std::to_string(decoded.frame_counters.received) +
+                               " frames of " + (co.interface.empty() ? std::string("any interface") : co.interface) +
+                               ", " + std::to_string(decoded.frame_counters.foreign) + " with other ids, " +
+                               std::to_string(decoded.other_interfaces) + " of other interfaces)");
+    made.driver = std::make_unique<drivers::ReplayDriver>(std::move(decoded.samples), options, made.source);
+  } catch (const drivers::CandumpFileError& e) {
+    throw std::runtime_error(where + e.what());
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(where + e.what());
+  }
+  return made;
+}
+
 MadeDriver make_replay(const StreamConfig& stream) {
   const ReplaySourceConfig& rc = stream.driver.replay;
+  if (!rc.candump.empty()) return make_candump_replay(stream);
   drivers::ReplayOptions options = rc.options;
   options.stream_id = stream.id;
   const std::string where = "stream '" + stream.name + "': replay " + rc.path.string() + ": ";
@@ -136,6 +177,29 @@ MadeDriver make_hid(const StreamConfig& stream) {
   return made;
 }
 
+MadeDriver make_socketcan(const StreamConfig& stream) {
+  const SocketCanSourceConfig& sc = stream.driver.socketcan;
+  drivers::SocketCanDriverOptions o;
+  o.interface = sc.interface;
+  o.protocol = sc.protocol;
+  o.decoder_options = sc.decoder;
+  o.fd = sc.fd;
+  o.stream_id = stream.id;
+  o.reconnect_min = sc.reconnect_min;
+  o.reconnect_max = sc.reconnect_max;
+  o.time_source = sc.time_source;
+  o.log = to_spdlog(stream.name);
+  MadeDriver made;
+  made.source = "socketcan:" + sc.interface + " (" + sc.protocol + ")";
+  o.name = made.source;
+  try {
+    made.driver = std::make_unique<drivers::SocketCanDriver>(std::move(o));
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("stream '" + stream.name + "': " + e.what());
+  }
+  return made;
+}
+
 }  // namespace
 
 MadeDriver make_driver(const StreamConfig& stream) {
@@ -146,6 +210,8 @@ MadeDriver make_driver(const StreamConfig& stream) {
       return make_synthetic(stream);
     case DriverType::Serial:
       return make_serial(stream);
+    case DriverType::SocketCan:
+      return make_socketcan(stream);
     case DriverType::Hid:
       return make_hid(stream);
   }

@@ -475,6 +475,56 @@ driver = { type = "hid", device = "/dev/hidraw4", protocol = "hid-vendor", offse
   EXPECT_EQ(d.vendor.scale, 1.0 / 16384.0);
 }
 
+TEST(Config, SocketCanSourcesAndCandumpReplaysTakeTheirKeys) {
+  testing::ScratchDir dir("posefair-config-");
+  write_file(dir / "bus.log", "(1.000000) can0 021#7FFF000000000000\n");
+  const DaemonConfig c = parse_config(R"toml(
+[[stream]]
+id = 1
+name = "glove"
+driver = { type = "socketcan", interface = "can0", protocol = "posefair-can", posefair_base_id = 0x204, posefair_id_format = "extended", fd = true, time_source = "receive", reconnect_min = 0.2, reconnect_max = 2.0 }
+[[stream]]
+id = 2
+name = "mti"
+driver = { type = "socketcan", interface = "vcan1", protocol = "xsens-can", xsens_quaternion_id = "0x121", xsens_sample_time_unit = "1us" }
+[[stream]]
+id = 3
+name = "ahrs"
+driver = { type = "socketcan", interface = "can1", protocol = "dronecan-ahrs", dronecan_node_id = 42 }
+[[stream]]
+id = 4
+name = "recorded"
+driver = { type = "replay", candump = "bus.log", interface = "can0", protocol = "xsens-can", timing = "fast", time_source = "device" }
+)toml", dir / "cfg.toml");
+  ASSERT_EQ(c.streams.size(), 4u);
+  ASSERT_EQ(c.streams[0].driver.type, DriverType::SocketCan);
+  const SocketCanSourceConfig& a = c.streams[0].driver.socketcan;
+  EXPECT_EQ(a.interface, "can0");
+  EXPECT_EQ(a.protocol, "posefair-can");
+  EXPECT_EQ(a.decoder.posefair_base_id, "516");
+  EXPECT_EQ(a.decoder.posefair_id_format, "extended");
+  EXPECT_TRUE(a.fd);
+  EXPECT_EQ(a.time_source, drivers::TimeSource::Receive);
+  EXPECT_EQ(a.reconnect_min, 0.2);
+  EXPECT_EQ(a.reconnect_max, 2.0);
+  const SocketCanSourceConfig& b = c.streams[1].driver.socketcan;
+  EXPECT_EQ(b.decoder.xsens_quaternion_id, "0x121");
+  EXPECT_EQ(b.decoder.xsens_sample_time_unit, "1us");
+  EXPECT_FALSE(b.fd);
+  EXPECT_EQ(b.reconnect_min, 0.1);
+  EXPECT_EQ(b.reconnect_max, 5.0);
+  EXPECT_EQ(c.streams[2].driver.socketcan.decoder.dronecan_node_id, "42");
+  ASSERT_EQ(c.streams[3].driver.type, DriverType::Replay);
+  const ReplaySourceConfig& r = c.streams[3].driver.replay;
+  EXPECT_EQ(r.candump, dir / "bus.log");
+  EXPECT_TRUE(r.path.empty());
+  EXPECT_EQ(r.can.interface, "can0");
+  EXPECT_EQ(r.can.protocol, "xsens-can");
+  EXPECT_EQ(r.can.time_source, drivers::TimeSource::Device);
+  EXPECT_EQ(r.options.timing, drivers::ReplayTiming::AsFastAsPossible);
+  EXPECT_EQ(r.options.stream_id, 4u);
+}
+
 TEST(Config, TheSplineTableSetsBridgingAndResampling) {
   const DaemonConfig c = parse_config(R"toml(
 [[stream]]
@@ -821,8 +871,8 @@ name = "a"
 id = 1
 name = "a"
 [stream.driver]
-type = "socketcan"
-)", "stream[1].driver.type: expected one of 'replay', 'synthetic', 'serial', 'hid', got 'socketcan'", 5},
+type = "modbus"
+)", "stream[1].driver.type: expected one of 'replay', 'synthetic', 'serial', 'socketcan', 'hid', got 'modbus'", 5},
     {"replay key on a synthetic driver", R"([[stream]]
 id = 1
 name = "a"
@@ -1436,6 +1486,91 @@ chip = "gpiochip0"
 data_ready_line = 3
 toleranse_max = 0.002
 )", "stream[1].gpio.toleranse_max: unknown key (did you mean 'tolerance_max'?)", 8},
+    {"socketcan: unknown protocol", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "socketcan", interface = "can0", protocol = "xsens" }
+)", "stream[1].driver.protocol: unknown CAN protocol 'xsens' (known: dronecan-ahrs, posefair-can, xsens-can)", 4},
+    {"socketcan: a bad identifier, judged by the decoder", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "socketcan"
+interface = "can0"
+protocol = "posefair-can"
+posefair_base_id = "0x2G0"
+)", "stream[1].driver.posefair_base_id: ", 8},
+    {"socketcan: an option of another protocol", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "socketcan", interface = "can0", protocol = "posefair-can", dronecan_node_id = 42 }
+)", "stream[1].driver.dronecan_node_id: only for protocol 'dronecan-ahrs' (this source's protocol is 'posefair-can')", 4},
+    {"socketcan: interface missing", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "socketcan"
+protocol = "xsens-can"
+)", "stream[1].driver.interface: missing required key", 4},
+    {"socketcan: interface name too long", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "socketcan", interface = "can0-on-the-left-arm", protocol = "xsens-can" }
+)", "stream[1].driver.interface: an interface name has at most 15 characters", 4},
+    {"socketcan: fd as a string", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "socketcan", interface = "can0", protocol = "xsens-can", fd = "yes" }
+)", "stream[1].driver.fd: expected a boolean, got a string", 4},
+    {"socketcan: a serial key", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "socketcan", interface = "can0", protocol = "xsens-can", baud = 1000000 }
+)", "stream[1].driver.baud: unknown key for driver type socketcan (it belongs to type serial)", 4},
+    {"socketcan: reconnect_max below reconnect_min", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "socketcan", interface = "can0", protocol = "xsens-can", reconnect_min = 2, reconnect_max = 1 }
+)", "stream[1].driver.reconnect_max: must be >= reconnect_min (2 s), got 1", 4},
+    {"socketcan: a bad dronecan node id", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "socketcan", interface = "can0", protocol = "dronecan-ahrs", dronecan_node_id = 200 }
+)", "stream[1].driver.dronecan_node_id: ", 4},
+    {"candump replay: also a path", R"([[stream]]
+id = 1
+name = "a"
+[stream.driver]
+type = "replay"
+candump = "bus.log"
+path = "poses.csv"
+protocol = "xsens-can"
+)", "stream[1].driver.path: not for a candump log (candump is set at line 6)", 7},
+    {"candump replay: no such file", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "replay", candump = "missing.log", protocol = "xsens-can" }
+)", "stream[1].driver.candump: no such file: ", 4},
+    {"candump replay: protocol missing", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "replay", candump = "bus.log", interface = "can0" }
+)", "stream[1].driver.protocol: missing required key", 4},
+    {"candump replay: unknown protocol", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "replay", candump = "bus.log", protocol = "posefair-cam" }
+)", "stream[1].driver.protocol: unknown CAN protocol 'posefair-cam' (known: dronecan-ahrs, posefair-can, xsens-can) (did you mean 'posefair-can'?)", 4},
+    {"replay: a CAN protocol without candump", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "replay", path = "poses.csv", protocol = "xsens-can" }
+)", "stream[1].driver.protocol: only for a candump log (key candump)", 4},
+    {"candump replay: fd is the live driver's", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "replay", candump = "bus.log", protocol = "xsens-can", fd = true }
+)", "stream[1].driver.fd: unknown key for driver type replay (it belongs to type socketcan)", 4},
     {"a table that is not one", R"(daemon = 5
 [[stream]]
 id = 1
@@ -1448,6 +1583,7 @@ TEST(Config, MalformedConfigsAreRefusedWithFileLineAndKey) {
   testing::ScratchDir dir("posefair-config-");
   write_file(dir / "poses.csv", "t,qw,qx,qy,qz\n0,1,0,0,0\n");
   write_file(dir / "walk.bvh", "");
+  write_file(dir / "bus.log", "(1.000000) can0 021#7FFF000000000000\n");
   const std::filesystem::path file = dir / "cfg.toml";
   EXPECT_GE(kBadConfigs.size(), 25u);
   for (const BadConfig& bad : kBadConfigs) {

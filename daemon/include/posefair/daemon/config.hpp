@@ -19,6 +19,7 @@
 #include "posefair/daemon/overflow_policy.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
+#include "posefair/drivers/can_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
 #include "posefair/drivers/hidraw_driver.hpp"
 #include "posefair/drivers/gpio_data_ready.hpp"
@@ -70,6 +71,20 @@ struct DaemonSettings {
   int realtime_priority = 0;
 };
 
+// [stream.driver] with type = "socketcan": trackers on a CAN bus (drivers/socketcan_driver.hpp),
+// a raw CAN socket on a named interface, its frames decoded by a CAN protocol decoder. The
+// interface need not exist at load: the driver waits for it. Also what a candump replay
+// shares with it (interface, protocol, decoder options, time_source).
+struct SocketCanSourceConfig {
+  std::string interface;              // e.g. "can0"; for a candump replay empty = every interface
+  std::string protocol;               // one of drivers::can_decoder_protocols()
+  drivers::CanDecoderOptions decoder; // posefair_*, xsens_*, dronecan_node_id
+  bool fd = false;                    // also receive CAN FD frames
+  drivers::TimeSource time_source = drivers::TimeSource::Auto;
+  double reconnect_min = 0.1;         // s
+  double reconnect_max = 5.0;         // s, >= reconnect_min
+};
+
 // [stream.driver] with type = "replay": the simulated device backend.
 struct ReplaySourceConfig {
   std::filesystem::path path;          // absolute after loading (resolved against the config's directory)
@@ -77,6 +92,10 @@ struct ReplaySourceConfig {
   // Sample logs hold several streams: which recorded stream id to play (its samples get this
   // stream's id). Unset: the log must hold exactly one stream. Pose files: ignored.
   std::optional<std::uint32_t> source_stream;
+  // A candump log (key `candump`, instead of `path`): absolute after loading, its frames decoded
+  // by `can` (interface, protocol and options; reconnect_* and fd unused). Empty: not one.
+  std::filesystem::path candump;
+  SocketCanSourceConfig can;
 };
 
 // [stream.driver] with type = "synthetic": smooth motion plus bounded noise at a fixed rate,
@@ -116,7 +135,7 @@ struct HidSourceConfig {
   double reconnect_max = 5.0;                    // s, >= reconnect_min
 };
 
-enum class DriverType { Replay, Synthetic, Serial, Hid };
+enum class DriverType { Replay, Synthetic, Serial, SocketCan, Hid };
 
 struct DriverConfig {
   DriverType type = DriverType::Replay;
@@ -124,6 +143,7 @@ struct DriverConfig {
   SyntheticSourceConfig synthetic;  // type == Synthetic
   SerialSourceConfig serial;        // type == Serial
   HidSourceConfig hid;              // type == Hid
+  SocketCanSourceConfig socketcan;  // type == SocketCan
 };
 
 // [stream.spline]: the geometric spline around the fairing window (docs/splines.md, "In the
