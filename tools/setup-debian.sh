@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package posefair needs to build, test and benchmark.
 # Idempotent: when everything is present it only checks and prints nothing.
-#   tools/setup-debian.sh           build + test dependencies
+#   tools/setup-debian.sh           build dependencies (what tools/demo.sh needs)
+#   tools/setup-debian.sh --tests   also the kernel interface tests' VM and peers (tools/test.sh)
 #   tools/setup-debian.sh --plots   also what tools/plot_*.py need (matplotlib)
 set -euo pipefail
 
@@ -20,15 +21,15 @@ packages=(
   zlib1g-dev             # CRC-32 of the sample log (drivers)
   libserialport-dev      # the serial driver: ports by path or USB id, settings (drivers)
   libnlopt-cxx-dev       # the quaternion spline optimiser (core)
+  libgpiod-dev           # GPIO data-ready and scope lines, libgpiod 1.6 (drivers)
 )
 # The hw tests' VM (tests/hw/vm/): Debian's own kernel under qemu, gpio-sim built against its
 # headers, and the tests' independent peers. Only amd64 boots that kernel.
-if [[ $(dpkg --print-architecture) == amd64 ]]; then
+if [[ "${1:-}" == "--tests" && $(dpkg --print-architecture) == amd64 ]]; then
   packages+=(qemu-system-x86 linux-image-amd64 linux-headers-amd64 busybox-static kmod cpio
              xz-utils zstd file make gcc libc6-dev
-             can-utils python3-can gpiod)
+             iproute2 can-utils python3-can)
 fi
-packages+=(libgpiod-dev)     # the GPIO line driver (drivers)
 if [[ "${1:-}" == "--plots" ]]; then
   packages+=(python3 python3-matplotlib python3-numpy)
 fi

@@ -7,7 +7,7 @@
 # Installs missing Debian packages first.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-tools/setup-debian.sh
+tools/setup-debian.sh --tests
 jobs=$(nproc 2>/dev/null || echo 2)
 
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
@@ -25,7 +25,7 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPOSEFAIR_SANITIZE_THREAD=ON \
   -DPOSEFAIR_BUILD_BENCHMARKS=OFF >/dev/null
 threaded=(tests/daemon/ring_tests tests/daemon/pipeline_tests tests/daemon/daemon_e2e_tests tests/replaylog/replaylog_tests
-          tests/drivers/serial_tests)
+          tests/drivers/serial_tests tests/drivers/hidraw_tests tests/daemon/daemon_can_e2e_tests)
 cmake --build build-tsan -j "$jobs" --target posefaird posefair "${threaded[@]##*/}"
 # Each binary runs whole (ctest's per-test labels cannot carry a list through gtest discovery).
 for t in "${threaded[@]}"; do

@@ -618,9 +618,11 @@ class Parser {
     return c;
   }
 
-  // [stream.driver] with type = "serial". The device is not opened (nor required to exist):
-  // the driver waits for it.
-  void parse_serial(const toml::table& t, const std::string& prefix, SerialSourceConfig& c) const {
+  // device (an absolute path) or usb ("VID:PID", hexadecimal) with an optional serial_number:
+  // how serial and HID sources name their device. The examples go into the error messages.
+  void parse_device_selection(const toml::table& t, const std::string& prefix, std::string_view path_example,
+                              std::string_view usb_example, std::string& device_out,
+                              std::optional<drivers::UsbId>& usb_out, std::string& serial_out) const {
     auto key = [&](std::string_view name) { return join_key(prefix, name); };
     const toml::node* device = t.get("device");
     const toml::node* usb = t.get("usb");
@@ -632,19 +634,50 @@ class Parser {
     if (device != nullptr) {
       const std::string path = get_nonempty_string(*device, key("device"));
       if (!std::filesystem::path(path).is_absolute())
-        fail(*device, key("device"), "must be an absolute path, e.g. '/dev/ttyUSB0' or '/dev/serial/by-id/...', got " + in_quotes(path));
-      c.port.device = path;
+        fail(*device, key("device"), "must be an absolute path, e.g. " + std::string(path_example) + ", got " + in_quotes(path));
+      device_out = path;
     }
     if (usb != nullptr) {
       const std::string text = get_string(*usb, key("usb"));
-      c.port.usb = drivers::parse_usb_id(text);
-      if (!c.port.usb)
-        fail(*usb, key("usb"), "not a USB id: " + in_quotes(text) + "; expected VID:PID in hexadecimal, e.g. '1a86:7523'");
+      usb_out = drivers::parse_usb_id(text);
+      if (!usb_out)
+        fail(*usb, key("usb"), "not a USB id: " + in_quotes(text) + "; expected VID:PID in hexadecimal, e.g. " + std::string(usb_example));
     }
     if (const toml::node* n = t.get("serial_number")) {
       if (usb == nullptr) fail(*n, key("serial_number"), "only with usb (it selects among devices of one USB id)");
-      c.port.usb_serial = get_nonempty_string(*n, key("serial_number"));
+      serial_out = get_nonempty_string(*n, key("serial_number"));
     }
+  }
+
+  // time_source of a device source (time_base.hpp).
+  void parse_time_source(const toml::table& t, const std::string& prefix, drivers::TimeSource& out) const {
+    if (const toml::node* n = t.get("time_source"))
+      out = get_choice<drivers::TimeSource>(*n, join_key(prefix, "time_source"),
+                                            {{"auto", drivers::TimeSource::Auto},
+                                             {"receive", drivers::TimeSource::Receive},
+                                             {"device", drivers::TimeSource::Device}});
+  }
+
+  // reconnect_min and reconnect_max of a device source: the backoff between open attempts.
+  void parse_reconnect(const toml::table& t, const std::string& prefix, double& min, double& max) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    const toml::node* min_node = t.get("reconnect_min");
+    const toml::node* max_node = t.get("reconnect_max");
+    if (min_node != nullptr) min = get_float(*min_node, key("reconnect_min"), FloatRange{0.0, true, 60.0, false});
+    if (max_node != nullptr) max = get_float(*max_node, key("reconnect_max"), FloatRange{0.0, true, 3600.0, false});
+    if (max < min) {
+      if (max_node != nullptr)
+        fail(*max_node, key("reconnect_max"), "must be >= reconnect_min (" + number(min) + " s), got " + number(max));
+      fail(*min_node, key("reconnect_min"), "must be <= reconnect_max (" + number(max) + " s, the default), got " + number(min));
+    }
+  }
+
+  // [stream.driver] with type = "serial". The device is not opened (nor required to exist):
+  // the driver waits for it.
+  void parse_serial(const toml::table& t, const std::string& prefix, SerialSourceConfig& c) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    parse_device_selection(t, prefix, "'/dev/ttyUSB0' or '/dev/serial/by-id/...'", "'1a86:7523'", c.port.device,
+                           c.port.usb, c.port.usb_serial);
 
     drivers::SerialSettings& st = c.settings;
     if (const toml::node* n = t.get("baud")) st.baud = static_cast<int>(get_int(*n, key("baud"), 50, 12000000));
@@ -685,20 +718,8 @@ class Parser {
         option_key = key(po.key);
       }
     }
-    if (const toml::node* n = t.get("time_source"))
-      c.time_source = get_choice<drivers::TimeSource>(*n, key("time_source"),
-                                                      {{"auto", drivers::TimeSource::Auto},
-                                                       {"receive", drivers::TimeSource::Receive},
-                                                       {"device", drivers::TimeSource::Device}});
-    const toml::node* min_node = t.get("reconnect_min");
-    const toml::node* max_node = t.get("reconnect_max");
-    if (min_node != nullptr) c.reconnect_min = get_float(*min_node, key("reconnect_min"), FloatRange{0.0, true, 60.0, false});
-    if (max_node != nullptr) c.reconnect_max = get_float(*max_node, key("reconnect_max"), FloatRange{0.0, true, 3600.0, false});
-    if (c.reconnect_max < c.reconnect_min) {
-      if (max_node != nullptr)
-        fail(*max_node, key("reconnect_max"), "must be >= reconnect_min (" + number(c.reconnect_min) + " s), got " + number(c.reconnect_max));
-      fail(*min_node, key("reconnect_min"), "must be <= reconnect_max (" + number(c.reconnect_max) + " s, the default), got " + number(c.reconnect_min));
-    }
+    parse_time_source(t, prefix, c.time_source);
+    parse_reconnect(t, prefix, c.reconnect_min, c.reconnect_max);
 
     // Last, so that every other key is judged the same whichever decoders this build has.
     const std::vector<std::string> known = drivers::decoder_protocols();
@@ -739,11 +760,7 @@ class Parser {
         option_key = key(po.key);
       }
     }
-    if (const toml::node* n = t.get("time_source"))
-      c.time_source = get_choice<drivers::TimeSource>(*n, key("time_source"),
-                                                      {{"auto", drivers::TimeSource::Auto},
-                                                       {"receive", drivers::TimeSource::Receive},
-                                                       {"device", drivers::TimeSource::Device}});
+    parse_time_source(t, prefix, c.time_source);
     const std::vector<std::string> known = drivers::can_decoder_protocols();
     if (std::find(known.begin(), known.end(), c.protocol) == known.end()) {
       std::string list;
@@ -776,15 +793,7 @@ class Parser {
     auto key = [&](std::string_view name) { return join_key(prefix, name); };
     c.interface = get_interface(require(t, "interface", prefix), key("interface"));
     if (const toml::node* n = t.get("fd")) c.fd = get_bool(*n, key("fd"));
-    const toml::node* min_node = t.get("reconnect_min");
-    const toml::node* max_node = t.get("reconnect_max");
-    if (min_node != nullptr) c.reconnect_min = get_float(*min_node, key("reconnect_min"), FloatRange{0.0, true, 60.0, false});
-    if (max_node != nullptr) c.reconnect_max = get_float(*max_node, key("reconnect_max"), FloatRange{0.0, true, 3600.0, false});
-    if (c.reconnect_max < c.reconnect_min) {
-      if (max_node != nullptr)
-        fail(*max_node, key("reconnect_max"), "must be >= reconnect_min (" + number(c.reconnect_min) + " s), got " + number(c.reconnect_max));
-      fail(*min_node, key("reconnect_min"), "must be <= reconnect_max (" + number(c.reconnect_max) + " s, the default), got " + number(c.reconnect_min));
-    }
+    parse_reconnect(t, prefix, c.reconnect_min, c.reconnect_max);
     parse_can_decoder(t, prefix, c);
   }
 
@@ -821,29 +830,7 @@ class Parser {
   // required to exist): the driver waits for it, and hid-sensor reads its layout from it.
   void parse_hid(const toml::table& t, const std::string& prefix, HidSourceConfig& c) const {
     auto key = [&](std::string_view name) { return join_key(prefix, name); };
-    const toml::node* device = t.get("device");
-    const toml::node* usb = t.get("usb");
-    if (device != nullptr && usb != nullptr)
-      fail(*usb, key("usb"), "give either device or usb, not both (device is set at line " +
-                                 std::to_string(device->source().begin.line) + ")");
-    if (device == nullptr && usb == nullptr)
-      fail(t.source().begin, key("device"), "missing required key: device (a path) or usb (\"VID:PID\")");
-    if (device != nullptr) {
-      const std::string path = get_nonempty_string(*device, key("device"));
-      if (!std::filesystem::path(path).is_absolute())
-        fail(*device, key("device"), "must be an absolute path, e.g. '/dev/hidraw0', got " + in_quotes(path));
-      c.device.device = path;
-    }
-    if (usb != nullptr) {
-      const std::string text = get_string(*usb, key("usb"));
-      c.device.usb = drivers::parse_usb_id(text);
-      if (!c.device.usb)
-        fail(*usb, key("usb"), "not a USB id: " + in_quotes(text) + "; expected VID:PID in hexadecimal, e.g. '0483:5750'");
-    }
-    if (const toml::node* n = t.get("serial_number")) {
-      if (usb == nullptr) fail(*n, key("serial_number"), "only with usb (it selects among devices of one USB id)");
-      c.device.serial = get_nonempty_string(*n, key("serial_number"));
-    }
+    parse_device_selection(t, prefix, "'/dev/hidraw0'", "'0483:5750'", c.device.device, c.device.usb, c.device.serial);
 
     const toml::node& protocol_node = require(t, "protocol", prefix);
     c.protocol = get_choice<drivers::HidProtocol>(protocol_node, key("protocol"),
@@ -860,20 +847,8 @@ class Parser {
     else
       parse_hid_vendor(t, prefix, c.vendor);
 
-    if (const toml::node* n = t.get("time_source"))
-      c.time_source = get_choice<drivers::TimeSource>(*n, key("time_source"),
-                                                      {{"auto", drivers::TimeSource::Auto},
-                                                       {"receive", drivers::TimeSource::Receive},
-                                                       {"device", drivers::TimeSource::Device}});
-    const toml::node* min_node = t.get("reconnect_min");
-    const toml::node* max_node = t.get("reconnect_max");
-    if (min_node != nullptr) c.reconnect_min = get_float(*min_node, key("reconnect_min"), FloatRange{0.0, true, 60.0, false});
-    if (max_node != nullptr) c.reconnect_max = get_float(*max_node, key("reconnect_max"), FloatRange{0.0, true, 3600.0, false});
-    if (c.reconnect_max < c.reconnect_min) {
-      if (max_node != nullptr)
-        fail(*max_node, key("reconnect_max"), "must be >= reconnect_min (" + number(c.reconnect_min) + " s), got " + number(c.reconnect_max));
-      fail(*min_node, key("reconnect_min"), "must be <= reconnect_max (" + number(c.reconnect_max) + " s, the default), got " + number(c.reconnect_min));
-    }
+    parse_time_source(t, prefix, c.time_source);
+    parse_reconnect(t, prefix, c.reconnect_min, c.reconnect_max);
   }
 
   void parse_hid_sensor(const toml::table& t, const std::string& prefix, drivers::HidSensorOrientationOptions& o) const {

@@ -131,6 +131,27 @@ drivers::DriverLog to_spdlog(const std::string& stream_name) {
   };
 }
 
+// A device driver (serial, SocketCAN, hidraw) from its options and its source's config: the
+// backoff and time source as configured, log lines to spdlog under the stream's name, `source`
+// naming it in logs and in the recording's stream table, and a refused option naming the stream.
+template <class Driver, class Options, class SourceConfig>
+MadeDriver make_device_driver(const StreamConfig& stream, const SourceConfig& config, Options o, std::string source) {
+  o.stream_id = stream.id;
+  o.reconnect_min = config.reconnect_min;
+  o.reconnect_max = config.reconnect_max;
+  o.time_source = config.time_source;
+  o.log = to_spdlog(stream.name);
+  o.name = source;
+  MadeDriver made;
+  made.source = std::move(source);
+  try {
+    made.driver = std::make_unique<Driver>(std::move(o));
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("stream '" + stream.name + "': " + e.what());
+  }
+  return made;
+}
+
 MadeDriver make_serial(const StreamConfig& stream) {
   const SerialSourceConfig& sc = stream.driver.serial;
   drivers::SerialDriverOptions o;
@@ -138,20 +159,8 @@ MadeDriver make_serial(const StreamConfig& stream) {
   o.settings = sc.settings;
   o.protocol = sc.protocol;
   o.decoder_options = sc.decoder;
-  o.stream_id = stream.id;
-  o.reconnect_min = sc.reconnect_min;
-  o.reconnect_max = sc.reconnect_max;
-  o.time_source = sc.time_source;
-  o.log = to_spdlog(stream.name);
-  MadeDriver made;
-  made.source = "serial:" + sc.port.describe() + " (" + sc.protocol + ")";
-  o.name = made.source;
-  try {
-    made.driver = std::make_unique<drivers::SerialDriver>(std::move(o));
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error("stream '" + stream.name + "': " + e.what());
-  }
-  return made;
+  return make_device_driver<drivers::SerialDriver>(stream, sc, std::move(o),
+                                                   "serial:" + sc.port.describe() + " (" + sc.protocol + ")");
 }
 
 MadeDriver make_hid(const StreamConfig& stream) {
@@ -161,20 +170,8 @@ MadeDriver make_hid(const StreamConfig& stream) {
   o.protocol = hc.protocol;
   o.sensor = hc.sensor;
   o.vendor = hc.vendor;
-  o.stream_id = stream.id;
-  o.reconnect_min = hc.reconnect_min;
-  o.reconnect_max = hc.reconnect_max;
-  o.time_source = hc.time_source;
-  o.log = to_spdlog(stream.name);
-  MadeDriver made;
-  made.source = "hid:" + hc.device.describe() + " (" + std::string(drivers::to_string(hc.protocol)) + ")";
-  o.name = made.source;
-  try {
-    made.driver = std::make_unique<drivers::HidrawDriver>(std::move(o));
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error("stream '" + stream.name + "': " + e.what());
-  }
-  return made;
+  return make_device_driver<drivers::HidrawDriver>(
+      stream, hc, std::move(o), "hid:" + hc.device.describe() + " (" + std::string(drivers::to_string(hc.protocol)) + ")");
 }
 
 MadeDriver make_socketcan(const StreamConfig& stream) {
@@ -184,20 +181,8 @@ MadeDriver make_socketcan(const StreamConfig& stream) {
   o.protocol = sc.protocol;
   o.decoder_options = sc.decoder;
   o.fd = sc.fd;
-  o.stream_id = stream.id;
-  o.reconnect_min = sc.reconnect_min;
-  o.reconnect_max = sc.reconnect_max;
-  o.time_source = sc.time_source;
-  o.log = to_spdlog(stream.name);
-  MadeDriver made;
-  made.source = "socketcan:" + sc.interface + " (" + sc.protocol + ")";
-  o.name = made.source;
-  try {
-    made.driver = std::make_unique<drivers::SocketCanDriver>(std::move(o));
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error("stream '" + stream.name + "': " + e.what());
-  }
-  return made;
+  return make_device_driver<drivers::SocketCanDriver>(stream, sc, std::move(o),
+                                                      "socketcan:" + sc.interface + " (" + sc.protocol + ")");
 }
 
 }  // namespace

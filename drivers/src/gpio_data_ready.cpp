@@ -15,14 +15,10 @@
 #include <stdexcept>
 #include <utility>
 
+#include "monotonic_clock.hpp"
+
 namespace posefair::drivers {
 namespace {
-
-double monotonic_seconds() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 int bias_flags(GpioBias b) {
   switch (b) {

@@ -24,24 +24,13 @@
 #include <utility>
 #include <variant>
 
+#include "link_log_text.hpp"
+#include "monotonic_clock.hpp"
 #include "posefair/drivers/hid_report_descriptor.hpp"
+#include "sample_stamper.hpp"
 
 namespace posefair::drivers {
 namespace {
-
-double monotonic_seconds() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-std::string format(const char* fmt, double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
-}
-
-std::string attempts_text(std::uint64_t n) { return std::to_string(n) + (n == 1 ? " attempt" : " attempts"); }
 
 // A hexadecimal number of 1..max_digits digits that fits 16 bits.
 std::optional<std::uint16_t> hex16(std::string_view s, std::size_t max_digits) {
@@ -58,46 +47,6 @@ std::string slurp_small(const std::filesystem::path& p) {
   out << in.rdbuf();
   return out.str();
 }
-
-// Turns decoded samples into Samples: stream id, sequence, the report's receive time, the time
-// base (as the serial driver does).
-class Stamper final : public DecodedSink {
- public:
-  Stamper(std::uint32_t stream_id, TimeBase& time_base, SampleSink& sink, std::uint64_t& sequence,
-          std::atomic<std::uint64_t>& samples, std::atomic<std::uint64_t>& dropped)
-      : stream_id_(stream_id), time_base_(time_base), sink_(sink), sequence_(sequence), samples_(samples), dropped_(dropped) {}
-
-  void set_receive_time(double t) { receive_time_ = t; }
-
-  void on_sample(const DecodedSample& d) override {
-    Sample s;
-    s.stream_id = stream_id_;
-    s.sequence = sequence_++;
-    s.receive_time = receive_time_;
-    s.orientation = d.orientation;
-    s.flags = d.flags & (kHasPosition | kHasDeviceTime);
-    if (s.has_position()) s.position = d.position;
-    std::optional<double> device;
-    if ((s.flags & kHasDeviceTime) != 0) {
-      s.device_time = d.device_time;
-      device = d.device_time;
-    }
-    s.time = time_base_.update(receive_time_, device).time;
-    if (sink_.push(s))
-      samples_.fetch_add(1, std::memory_order_relaxed);
-    else
-      dropped_.fetch_add(1, std::memory_order_relaxed);
-  }
-
- private:
-  std::uint32_t stream_id_;
-  TimeBase& time_base_;
-  SampleSink& sink_;
-  std::uint64_t& sequence_;
-  std::atomic<std::uint64_t>& samples_;
-  std::atomic<std::uint64_t>& dropped_;
-  double receive_time_ = 0.0;
-};
 
 DecoderCounters& operator+=(DecoderCounters& a, const DecoderCounters& b) {
   a.bytes += b.bytes;
@@ -322,7 +271,7 @@ void HidrawDriver::run(std::stop_token stop, SampleSink& sink) {
   std::vector<std::uint8_t> buffer(kMaxReport);
   TimeBase time_base(options_.time_source, options_.time_base);
   std::uint64_t sequence = 0;
-  Stamper stamper(options_.stream_id, time_base, sink, sequence, samples_, dropped_);
+  SampleStamper stamper(options_.stream_id, time_base, sink, sequence, samples_, dropped_);
   Opened node;
   DecoderCounters past;  // of the decoders of earlier connections (hid-sensor builds one per open)
   auto decoder = [&]() -> HidReportDecoder& { return node.decoder ? *node.decoder : *vendor_decoder_; };
@@ -345,7 +294,7 @@ void HidrawDriver::run(std::stop_token stop, SampleSink& sink) {
     }
   };
 
-  const std::string backoff = format("%g s", options_.reconnect_min) + " .. " + format("%g s", options_.reconnect_max);
+  const std::string backoff = backoff_text(options_.reconnect_min) + " .. " + backoff_text(options_.reconnect_max);
   bool lost = false;
   double waiting_since = monotonic_seconds();
   std::uint64_t attempts = 0;
@@ -378,11 +327,11 @@ void HidrawDriver::run(std::stop_token stop, SampleSink& sink) {
       const std::string where = node.path == options_.device.device ? node.path : options_.device.describe() + " -> " + node.path;
       if (lost) {
         reconnects_.fetch_add(1, std::memory_order_relaxed);
-        log(LogLevel::Info, "reopened " + where + " after " + format("%.1f s", waited) + " and " + attempts_text(attempts + 1));
+        log(LogLevel::Info, "reopened " + where + " after " + seconds_text(waited) + " and " + attempts_text(attempts + 1));
       } else {
         std::string line = "opened " + where + ", protocol " + std::string(to_string(options_.protocol)) + " (" + node.what +
                            "), time source " + std::string(to_string(options_.time_source));
-        if (attempts > 0) line += " after " + format("%.1f s", waited) + " and " + attempts_text(attempts + 1);
+        if (attempts > 0) line += " after " + seconds_text(waited) + " and " + attempts_text(attempts + 1);
         log(LogLevel::Info, line);
       }
       if (!node.note.empty() && node.note != logged_note) {

@@ -15,15 +15,11 @@
 #include <stdexcept>
 #include <utility>
 
+#include "monotonic_clock.hpp"
+
 namespace posefair::drivers {
 
 namespace {
-
-double monotonic_seconds() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 bool starts_with_log_magic(const std::filesystem::path& path) {
   std::FILE* f = std::fopen(path.c_str(), "rbe");

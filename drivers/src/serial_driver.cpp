@@ -12,28 +12,12 @@
 #include <utility>
 #include <vector>
 
+#include "link_log_text.hpp"
+#include "monotonic_clock.hpp"
+#include "sample_stamper.hpp"
+
 namespace posefair::drivers {
 namespace {
-
-double monotonic_seconds() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-std::string seconds_text(double s) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f s", s);
-  return buf;
-}
-
-std::string backoff_text(double s) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g s", s);
-  return buf;
-}
-
-std::string attempts_text(std::uint64_t n) { return std::to_string(n) + (n == 1 ? " attempt" : " attempts"); }
 
 std::unique_ptr<Decoder> take_decoder(SerialDriverOptions& o) {
   if (o.decoder) return std::move(o.decoder);
@@ -45,45 +29,6 @@ std::unique_ptr<Decoder> take_decoder(SerialDriverOptions& o) {
   }
   return d;
 }
-
-// Turns decoded samples into Samples: stream id, sequence, the read's receive time, the time base.
-class Stamper final : public DecodedSink {
- public:
-  Stamper(std::uint32_t stream_id, TimeBase& time_base, SampleSink& sink, std::uint64_t& sequence,
-          std::atomic<std::uint64_t>& samples, std::atomic<std::uint64_t>& dropped)
-      : stream_id_(stream_id), time_base_(time_base), sink_(sink), sequence_(sequence), samples_(samples), dropped_(dropped) {}
-
-  void set_receive_time(double t) { receive_time_ = t; }
-
-  void on_sample(const DecodedSample& d) override {
-    Sample s;
-    s.stream_id = stream_id_;
-    s.sequence = sequence_++;
-    s.receive_time = receive_time_;
-    s.orientation = d.orientation;
-    s.flags = d.flags & (kHasPosition | kHasDeviceTime);
-    if (s.has_position()) s.position = d.position;
-    std::optional<double> device;
-    if ((s.flags & kHasDeviceTime) != 0) {
-      s.device_time = d.device_time;
-      device = d.device_time;
-    }
-    s.time = time_base_.update(receive_time_, device).time;
-    if (sink_.push(s))
-      samples_.fetch_add(1, std::memory_order_relaxed);
-    else
-      dropped_.fetch_add(1, std::memory_order_relaxed);
-  }
-
- private:
-  std::uint32_t stream_id_;
-  TimeBase& time_base_;
-  SampleSink& sink_;
-  std::uint64_t& sequence_;
-  std::atomic<std::uint64_t>& samples_;
-  std::atomic<std::uint64_t>& dropped_;
-  double receive_time_ = 0.0;
-};
 
 // Consecutive transient read errors after which the port is treated as gone and reopened.
 constexpr int kTransientLimit = 10;
@@ -168,7 +113,7 @@ void SerialDriver::run(std::stop_token stop, SampleSink& sink) {
   std::vector<std::uint8_t> buffer(options_.read_buffer);
   TimeBase time_base(options_.time_source, options_.time_base);
   std::uint64_t sequence = 0;
-  Stamper stamper(options_.stream_id, time_base, sink, sequence, samples_, dropped_);
+  SampleStamper stamper(options_.stream_id, time_base, sink, sequence, samples_, dropped_);
   SerialPort port;
 
   const std::string backoff = backoff_text(options_.reconnect_min) + " .. " + backoff_text(options_.reconnect_max);

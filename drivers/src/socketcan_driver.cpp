@@ -24,6 +24,10 @@
 #include <utility>
 #include <vector>
 
+#include "link_log_text.hpp"
+#include "monotonic_clock.hpp"
+#include "sample_stamper.hpp"
+
 namespace posefair::drivers {
 namespace {
 
@@ -31,27 +35,11 @@ static_assert(CanFrame::kEffFlag == CAN_EFF_FLAG && CanFrame::kRtrFlag == CAN_RT
 static_assert(CanFrame::kFdBrs == CANFD_BRS && CanFrame::kFdEsi == CANFD_ESI);
 static_assert(CanFrame::kMaxFd == CANFD_MAX_DLEN && CanFrame::kMaxClassic == CAN_MAX_DLEN);
 
-double seconds_of(const timespec& ts) { return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec); }
-
 double clock_seconds(clockid_t clock) {
   timespec ts{};
   ::clock_gettime(clock, &ts);
   return seconds_of(ts);
 }
-
-std::string seconds_text(double s) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f s", s);
-  return buf;
-}
-
-std::string backoff_text(double s) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g s", s);
-  return buf;
-}
-
-std::string attempts_text(std::uint64_t n) { return std::to_string(n) + (n == 1 ? " attempt" : " attempts"); }
 
 std::string errno_text(int e) { return std::strerror(e); }
 
@@ -78,45 +66,6 @@ std::unique_ptr<CanDecoder> take_decoder(SocketCanDriverOptions& o) {
   }
   return d;
 }
-
-// Turns decoded samples into Samples: stream id, sequence, the frame's receive time, the time base.
-class Stamper final : public DecodedSink {
- public:
-  Stamper(std::uint32_t stream_id, TimeBase& time_base, SampleSink& sink, std::atomic<std::uint64_t>& samples,
-          std::atomic<std::uint64_t>& dropped)
-      : stream_id_(stream_id), time_base_(time_base), sink_(sink), samples_(samples), dropped_(dropped) {}
-
-  void set_receive_time(double t) { receive_time_ = t; }
-
-  void on_sample(const DecodedSample& d) override {
-    Sample s;
-    s.stream_id = stream_id_;
-    s.sequence = sequence_++;
-    s.receive_time = receive_time_;
-    s.orientation = d.orientation;
-    s.flags = d.flags & (kHasPosition | kHasDeviceTime);
-    if (s.has_position()) s.position = d.position;
-    std::optional<double> device;
-    if ((s.flags & kHasDeviceTime) != 0) {
-      s.device_time = d.device_time;
-      device = d.device_time;
-    }
-    s.time = time_base_.update(receive_time_, device).time;
-    if (sink_.push(s))
-      samples_.fetch_add(1, std::memory_order_relaxed);
-    else
-      dropped_.fetch_add(1, std::memory_order_relaxed);
-  }
-
- private:
-  std::uint32_t stream_id_;
-  TimeBase& time_base_;
-  SampleSink& sink_;
-  std::atomic<std::uint64_t>& samples_;
-  std::atomic<std::uint64_t>& dropped_;
-  std::uint64_t sequence_ = 0;  // from 0 per run(), across reconnects
-  double receive_time_ = 0.0;
-};
 
 // Why an open failed; each is logged once per wait.
 enum class OpenFailure { NoInterface, Down, Other };
@@ -380,7 +329,8 @@ void SocketCanDriver::run(std::stop_token stop, SampleSink& sink) {
 
   const int timeout_ms = std::max(1, static_cast<int>(std::lround(options_.read_timeout * 1000.0)));
   TimeBase time_base(options_.time_source, options_.time_base);
-  Stamper stamper(options_.stream_id, time_base, sink, samples_, dropped_);
+  std::uint64_t sequence = 0;  // from 0 per run(), across reconnects
+  SampleStamper stamper(options_.stream_id, time_base, sink, sequence, samples_, dropped_);
   CanSocket socket;
   const std::vector<CanFilter> filters = decoder_->filters();
   std::vector<Received> batch(kBatch);

@@ -309,6 +309,13 @@ TEST(GpioDaemon, EdgesTimeTheStreamsPosesAndTheOutputTogglesPerPublishedPose) {
     e.before = now_s();
     sim.pull(0, true);
     e.after = now_s();
+    // A device's bytes follow its data-ready edge by their transfer time (a posefair frame at
+    // 115200 baud: about 3 ms). The kernel stamps the edge in the interrupt but queues the event
+    // from the interrupt's thread; bytes written at once could be read by the daemon on the
+    // guest's other CPU before that thread has run. 30 ms stands for the transfer time with room
+    // for the emulated guest, and keeps unpaired samples (their receive times) out of the edge
+    // windows checked below.
+    std::this_thread::sleep_for(30ms);
     frame();
     edges.push_back(e);
     std::this_thread::sleep_for(200ms);  // the frame rate (5 Hz): a period longer than the window
