@@ -649,6 +649,29 @@ class Parser {
     }
   }
 
+  // A device source's protocol must be one of `known` ("unknown <what> ..." otherwise, with the
+  // list and a suggestion), and its decoder must accept the options: `make` builds it, and a
+  // refusal is blamed on the first decoder option given, else on the protocol.
+  template <class Make>
+  void check_protocol(const toml::node& protocol_node, const std::string& protocol_key, const std::string& protocol,
+                      const std::vector<std::string>& known, std::string_view what, const toml::node* option_node,
+                      const std::string& option_key, Make make) const {
+    if (std::find(known.begin(), known.end(), protocol) == known.end()) {
+      std::string list;
+      for (const std::string& p : known) list += (list.empty() ? "" : ", ") + p;
+      const std::vector<std::string_view> names(known.begin(), known.end());
+      fail(protocol_node, protocol_key,
+           "unknown " + std::string(what) + " " + in_quotes(protocol) + " (known: " + (list.empty() ? "none" : list) +
+               ")" + suggestion(protocol, names));
+    }
+    try {
+      make();  // the decoder judges its own options
+    } catch (const std::invalid_argument& e) {
+      if (option_node != nullptr) fail(*option_node, option_key, e.what());
+      fail(protocol_node, protocol_key, e.what());
+    }
+  }
+
   // time_source of a device source (time_base.hpp).
   void parse_time_source(const toml::table& t, const std::string& prefix, drivers::TimeSource& out) const {
     if (const toml::node* n = t.get("time_source"))
@@ -722,21 +745,8 @@ class Parser {
     parse_reconnect(t, prefix, c.reconnect_min, c.reconnect_max);
 
     // Last, so that every other key is judged the same whichever decoders this build has.
-    const std::vector<std::string> known = drivers::decoder_protocols();
-    if (std::find(known.begin(), known.end(), c.protocol) == known.end()) {
-      std::string list;
-      for (const std::string& p : known) list += (list.empty() ? "" : ", ") + p;
-      const std::vector<std::string_view> names(known.begin(), known.end());
-      fail(protocol_node, key("protocol"),
-           "unknown protocol " + in_quotes(c.protocol) + " (known: " + (list.empty() ? "none" : list) + ")" +
-               suggestion(c.protocol, names));
-    }
-    try {
-      (void)drivers::make_decoder(c.protocol, c.decoder);  // the decoder judges its own options
-    } catch (const std::invalid_argument& e) {
-      if (option_node != nullptr) fail(*option_node, option_key, e.what());
-      fail(protocol_node, key("protocol"), e.what());
-    }
+    check_protocol(protocol_node, key("protocol"), c.protocol, drivers::decoder_protocols(), "protocol", option_node,
+                   option_key, [&] { (void)drivers::make_decoder(c.protocol, c.decoder); });
   }
 
   // The CAN keys a live SocketCAN source and a candump replay share: protocol (required), its
@@ -761,21 +771,8 @@ class Parser {
       }
     }
     parse_time_source(t, prefix, c.time_source);
-    const std::vector<std::string> known = drivers::can_decoder_protocols();
-    if (std::find(known.begin(), known.end(), c.protocol) == known.end()) {
-      std::string list;
-      for (const std::string& p : known) list += (list.empty() ? "" : ", ") + p;
-      const std::vector<std::string_view> names(known.begin(), known.end());
-      fail(protocol_node, key("protocol"),
-           "unknown CAN protocol " + in_quotes(c.protocol) + " (known: " + (list.empty() ? "none" : list) + ")" +
-               suggestion(c.protocol, names));
-    }
-    try {
-      (void)drivers::make_can_decoder(c.protocol, c.decoder);  // the decoder judges its own options
-    } catch (const std::invalid_argument& e) {
-      if (option_node != nullptr) fail(*option_node, option_key, e.what());
-      fail(protocol_node, key("protocol"), e.what());
-    }
+    check_protocol(protocol_node, key("protocol"), c.protocol, drivers::can_decoder_protocols(), "CAN protocol",
+                   option_node, option_key, [&] { (void)drivers::make_can_decoder(c.protocol, c.decoder); });
   }
 
   // A network interface name as the kernel takes it: 1..15 characters, no '/', no blanks.
