@@ -52,10 +52,13 @@ else
   exit 1
 fi
 export DEBIAN_FRONTEND=noninteractive
-if ! "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/tmp/posefair-apt.log 2>&1; then
+# A fresh machine often has unattended-upgrades holding the dpkg lock for minutes: wait for it
+# (up to 10 minutes) rather than fail.
+apt=(apt-get -o DPkg::Lock::Timeout=600)
+if ! "${sudo[@]}" "${apt[@]}" install -y -qq --no-install-recommends "${missing[@]}" >/tmp/posefair-apt.log 2>&1; then
   # A fresh machine has no package lists yet: fetch them once and try again.
-  "${sudo[@]}" apt-get update -qq >>/tmp/posefair-apt.log 2>&1 || true
-  if ! "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >>/tmp/posefair-apt.log 2>&1; then
+  "${sudo[@]}" "${apt[@]}" update -qq >>/tmp/posefair-apt.log 2>&1 || true
+  if ! "${sudo[@]}" "${apt[@]}" install -y -qq --no-install-recommends "${missing[@]}" >>/tmp/posefair-apt.log 2>&1; then
     echo "setup: could not install some of: ${missing[*]}" >&2
     for p in "${missing[@]}"; do
       apt-cache policy "$p" 2>/dev/null | grep -q "Candidate: (none)" && echo "setup:   no installable candidate for '$p'" >&2
