@@ -5,5 +5,5 @@
 posefair_add_test(daemon_can_e2e_tests
   SOURCES daemon_can_e2e_tests.cpp
   LIBS posefair::protocol posefair::drivers
-  LABELS "daemon;network;e2e;can")
+  LABELS "daemon;network;e2e;can;threads")
 add_dependencies(daemon_can_e2e_tests posefaird)
