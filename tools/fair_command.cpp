@@ -20,7 +20,7 @@
 #include "posefair/core/causal_fairing.hpp"
 #include "posefair/core/fairing.hpp"
 #include "posefair/core/quality_metrics.hpp"
-#include "posefair/drivers/pose_file.hpp"
+#include "posefair/formats/pose_file.hpp"
 
 namespace posefair::tools {
 namespace {
@@ -28,7 +28,7 @@ namespace {
 struct FairOptions {
   std::string input;
   std::string output;
-  std::optional<drivers::PoseFormat> format;
+  std::optional<formats::PoseFormat> format;
   std::string joint;
   bool skip_missing = false;
   bool quiet = false;
@@ -43,20 +43,20 @@ struct FairOptions {
 };
 
 // Writes the result in the input's format; on failure says why and returns EX_CANTCREAT.
-int write_output(const FairOptions& o, const drivers::PoseFile& file, const PoseSequence& poses) {
+int write_output(const FairOptions& o, const formats::PoseFile& file, const PoseSequence& poses) {
   try {
-    drivers::write_pose_file(o.output, file, poses);
-  } catch (const drivers::PoseFileError& e) {
+    formats::write_pose_file(o.output, file, poses);
+  } catch (const formats::PoseFileError& e) {
     std::cerr << "posefair fair: " << e.what() << "\n";
     return kExitCantCreate;
   }
   return kExitOk;
 }
 
-void print_input_line(const FairOptions& o, const drivers::PoseFile& file, const char* rate_kind, double rate) {
+void print_input_line(const FairOptions& o, const formats::PoseFile& file, const char* rate_kind, double rate) {
   const PoseSequence& in = file.poses();
   std::printf("input    %s: %zu samples, %s, %s, %.1f Hz %s rate", o.input.c_str(), in.size(),
-              std::string(drivers::to_string(file.format())).c_str(),
+              std::string(formats::to_string(file.format())).c_str(),
               in.has_position() ? "orientation + position" : "orientation only", rate, rate_kind);
   if (file.skipped_rows() > 0) std::printf(", %zu rows without orientation skipped", file.skipped_rows());
   std::printf("\n");
@@ -68,7 +68,7 @@ void print_deviation_line(double max_dist_r, bool with_position, double max_devi
   std::printf("\n");
 }
 
-int run_causal(const FairOptions& o, const drivers::PoseFile& file) {
+int run_causal(const FairOptions& o, const formats::PoseFile& file) {
   const PoseSequence& in = file.poses();
   WindowConfig c = o.window;
   c.epsilon_r = o.eps_r_rotation / 2.0;
@@ -123,21 +123,21 @@ int run_fair(FairOptions o) {
       return kExitNoInput;
     }
   }
-  drivers::ReadOptions ro;
+  formats::ReadOptions ro;
   ro.format = o.format;
   ro.bvh_joint = o.joint;
   ro.skip_missing = o.skip_missing;
   // The user's bound is a physical rotation angle; the paper's eq. 20 bounds dist on S³ (half).
   o.params.epsilon_r = o.eps_r_rotation / 2.0;
 
-  std::optional<drivers::PoseFile> read;
+  std::optional<formats::PoseFile> read;
   try {
-    read.emplace(drivers::read_pose_file(o.input, ro));
-  } catch (const drivers::PoseFileError& e) {
+    read.emplace(formats::read_pose_file(o.input, ro));
+  } catch (const formats::PoseFileError& e) {
     std::cerr << "posefair fair: " << e.what() << "\n";
     return kExitDataErr;
   }
-  const drivers::PoseFile& file = *read;
+  const formats::PoseFile& file = *read;
   for (const std::string& w : file.warnings()) std::cerr << "posefair fair: warning: " << w << "\n";
   if (o.causal) return run_causal(o, file);
   const PoseSequence& in = file.poses();
@@ -176,8 +176,8 @@ void add_fair_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("fair", "Batch Lee & Shin motion fairing of a pose file (TUM, CSV, BVH joint)");
   cmd->add_option("input", o->input, "pose file to read")->required();
   cmd->add_option("-o,--output", o->output, "file to write, in the input's format (written atomically)")->required();
-  const std::map<std::string, drivers::PoseFormat> formats{
-      {"tum", drivers::PoseFormat::Tum}, {"csv", drivers::PoseFormat::Csv}, {"bvh", drivers::PoseFormat::Bvh}};
+  const std::map<std::string, formats::PoseFormat> formats{
+      {"tum", formats::PoseFormat::Tum}, {"csv", formats::PoseFormat::Csv}, {"bvh", formats::PoseFormat::Bvh}};
   cmd->add_option("--format", o->format, "input format (default: by extension .txt/.tum, .csv, .bvh)")
       ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
   cmd->add_option("--joint", o->joint, "BVH: the joint to fair");

@@ -8,12 +8,12 @@
 #include <sstream>
 #include <vector>
 
-#include "posefair/drivers/pose_file.hpp"
+#include "posefair/formats/pose_file.hpp"
 
 namespace posefair::tools {
 namespace {
 
-using drivers::PoseFileError;
+using formats::PoseFileError;
 
 std::vector<std::string> split_fields(const std::string& line) {
   std::vector<std::string> out;

@@ -9,7 +9,7 @@
 //
 // Every keyframe line of one file has the same layout. Times must increase strictly,
 // quaternions must have | |q| − 1 | <= 1e-3 (they are renormalised), and there must be at least
-// two keyframes. Any problem is a drivers::PoseFileError "<path>:<line>: <message>".
+// two keyframes. Any problem is a formats::PoseFileError "<path>:<line>: <message>".
 #include <filesystem>
 #include <iosfwd>
 #include <string>
@@ -21,7 +21,7 @@ namespace posefair::tools {
 inline constexpr double kKeyframeUnitTolerance = 1e-3;
 
 SplineKeyframes parse_keyframes(std::istream& in, const std::string& name);
-// Throws drivers::PoseFileError (line 0) when the file cannot be opened.
+// Throws formats::PoseFileError (line 0) when the file cannot be opened.
 SplineKeyframes read_keyframes(const std::filesystem::path& path);
 
 }  // namespace posefair::tools

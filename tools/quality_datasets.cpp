@@ -10,7 +10,7 @@
 
 #include "posefair/core/quality_metrics.hpp"
 #include "posefair/core/synthetic_motion.hpp"
-#include "posefair/drivers/pose_file.hpp"
+#include "posefair/formats/pose_file.hpp"
 
 namespace posefair::tools {
 namespace {
@@ -41,10 +41,10 @@ QualityDataset synthetic(double rate, double noise, bool quick) {
 // A SLAM estimate scored against motion capture, interpolated to the estimate's times and
 // brought into the estimate's frames (world and body alignment fitted on the raw estimate).
 QualityDataset tum(const std::filesystem::path& est_path, const std::filesystem::path& gt_path, const std::string& name) {
-  drivers::ReadOptions ro;
-  ro.format = drivers::PoseFormat::Tum;
-  const PoseSequence est = drivers::read_pose_file(est_path, ro).poses();
-  const PoseSequence gt = drivers::read_pose_file(gt_path, ro).poses();
+  formats::ReadOptions ro;
+  ro.format = formats::PoseFormat::Tum;
+  const PoseSequence est = formats::read_pose_file(est_path, ro).poses();
+  const PoseSequence gt = formats::read_pose_file(gt_path, ro).poses();
   QualityDataset d;
   d.name = name;
   d.kind = "tum";
@@ -111,9 +111,9 @@ QualityDataset broad(const std::filesystem::path& path, const std::string& name)
 
 // A BVH joint (frame 0, the T-pose, left out) with bounded random rotations added.
 QualityDataset bvh(const std::filesystem::path& path, const std::string& joint, double noise, const std::string& name) {
-  drivers::ReadOptions ro;
+  formats::ReadOptions ro;
   ro.bvh_joint = joint;
-  PoseSequence clean = drivers::read_pose_file(path, ro).poses();
+  PoseSequence clean = formats::read_pose_file(path, ro).poses();
   QualityDataset d;
   d.name = name;
   d.kind = "bvh";

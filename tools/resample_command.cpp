@@ -19,7 +19,7 @@
 
 #include "exit_codes.hpp"
 #include "posefair/core/pose_spline.hpp"
-#include "posefair/drivers/pose_file.hpp"
+#include "posefair/formats/pose_file.hpp"
 
 namespace posefair::tools {
 namespace {
@@ -29,8 +29,8 @@ namespace gs = geometric_splines;
 struct ResampleOptions {
   std::string input;
   std::string output;
-  std::optional<drivers::PoseFormat> format;
-  std::optional<drivers::PoseFormat> output_format;
+  std::optional<formats::PoseFormat> format;
+  std::optional<formats::PoseFormat> output_format;
   bool skip_missing = false;
   std::optional<double> rate;
   std::string times_file;
@@ -62,16 +62,16 @@ struct CommandError {
 };
 
 // The 1-based line of the n-th data row (0-based) of a TUM or CSV file, 0 when unknown.
-std::size_t data_line(const std::string& path, drivers::PoseFormat format, std::size_t n) {
+std::size_t data_line(const std::string& path, formats::PoseFormat format, std::size_t n) {
   std::ifstream in(path);
   std::string line;
   std::size_t number = 0, rows = 0;
-  bool header_seen = format != drivers::PoseFormat::Csv;
+  bool header_seen = format != formats::PoseFormat::Csv;
   while (std::getline(in, line)) {
     ++number;
     const auto first = line.find_first_not_of(" \t\r");
     if (first == std::string::npos) continue;
-    if (format == drivers::PoseFormat::Tum && line[first] == '#') continue;
+    if (format == formats::PoseFormat::Tum && line[first] == '#') continue;
     if (!header_seen) {
       header_seen = true;
       continue;
@@ -82,7 +82,7 @@ std::size_t data_line(const std::string& path, drivers::PoseFormat format, std::
 }
 
 // Strictly increasing sample times, else an error naming the file and line.
-void check_increasing(const ResampleOptions& o, const drivers::PoseFile& file) {
+void check_increasing(const ResampleOptions& o, const formats::PoseFile& file) {
   const auto& t = file.poses().time;
   if (t.size() < 2)
     throw CommandError{kExitDataErr, o.input + ": " + std::to_string(t.size()) +
@@ -220,16 +220,16 @@ int run_resample(const ResampleOptions& o) {
     std::ifstream probe(o.input);
     if (!probe) throw CommandError{kExitNoInput, "cannot open " + o.input + ": " + std::strerror(errno)};
   }
-  drivers::ReadOptions ro;
+  formats::ReadOptions ro;
   ro.format = o.format;
   ro.skip_missing = o.skip_missing;
-  std::optional<drivers::PoseFile> read;
+  std::optional<formats::PoseFile> read;
   try {
-    read.emplace(drivers::read_pose_file(o.input, ro));
-  } catch (const drivers::PoseFileError& e) {
+    read.emplace(formats::read_pose_file(o.input, ro));
+  } catch (const formats::PoseFileError& e) {
     throw CommandError{kExitDataErr, e.what()};
   }
-  if (read->format() == drivers::PoseFormat::Bvh)
+  if (read->format() == formats::PoseFormat::Bvh)
     throw CommandError{kExitUsage, o.input + ": resample reads TUM or CSV files"};
   for (const std::string& w : read->warnings()) std::cerr << "posefair resample: warning: " << w << "\n";
   check_increasing(o, *read);
@@ -245,7 +245,7 @@ int run_resample(const ResampleOptions& o) {
       if (times[i] >= in.time.front() && times[i] <= in.time.back()) continue;
       std::ostringstream m;
       m.precision(17);
-      m << o.times_file << ":" << data_line(o.times_file, drivers::PoseFormat::Tum, i) << ": time " << times[i]
+      m << o.times_file << ":" << data_line(o.times_file, formats::PoseFormat::Tum, i) << ": time " << times[i]
         << " is outside the data's range [" << in.time.front() << ", " << in.time.back() << "] of " << o.input
         << " (--clamp holds the end poses)";
       throw CommandError{kExitDataErr, m.str()};
@@ -261,14 +261,14 @@ int run_resample(const ResampleOptions& o) {
   }
   so3::make_continuous(out.orientation);
 
-  drivers::PoseFormat format = read->format();
+  formats::PoseFormat format = read->format();
   if (o.output_format) format = *o.output_format;
-  else if (auto by_name = drivers::format_from_extension(o.output); by_name && *by_name != drivers::PoseFormat::Bvh)
+  else if (auto by_name = formats::format_from_extension(o.output); by_name && *by_name != formats::PoseFormat::Bvh)
     format = *by_name;
-  const drivers::PoseFile document = format == drivers::PoseFormat::Tum ? drivers::make_tum(out) : drivers::make_csv(out);
+  const formats::PoseFile document = format == formats::PoseFormat::Tum ? formats::make_tum(out) : formats::make_csv(out);
   try {
-    drivers::write_pose_file(o.output, document, out);
-  } catch (const drivers::PoseFileError& e) {
+    formats::write_pose_file(o.output, document, out);
+  } catch (const formats::PoseFileError& e) {
     throw CommandError{kExitCantCreate, e.what()};
   }
   if (!o.derivatives.empty()) write_derivatives(o.derivatives, spline, times);
@@ -277,7 +277,7 @@ int run_resample(const ResampleOptions& o) {
                 in.has_position() ? "orientation + position" : "orientation only", in.time.back() - in.time.front());
     std::printf("spline   %s\n", describe(o.spline).c_str());
     std::printf("wrote    %s: %zu samples (%s)%s\n", o.output.c_str(), out.size(),
-                std::string(drivers::to_string(format)).c_str(), o.rate ? "" : ", at the given times");
+                std::string(formats::to_string(format)).c_str(), o.rate ? "" : ", at the given times");
     if (!o.derivatives.empty()) std::printf("wrote    %s: body angular velocity and acceleration\n", o.derivatives.c_str());
   }
   return kExitOk;
@@ -291,8 +291,8 @@ void add_resample_command(CLI::App& app, int& exit_code) {
                                  "Resample a pose file (TUM, CSV) with geometric C^k splines (Rodrigues, Silva Leite & Jakubiak)");
   cmd->add_option("input", o->input, "pose file to read (TUM or CSV)")->required();
   cmd->add_option("-o,--output", o->output, "file to write (format by extension, else the input's)");
-  const std::map<std::string, drivers::PoseFormat> formats{{"tum", drivers::PoseFormat::Tum},
-                                                           {"csv", drivers::PoseFormat::Csv}};
+  const std::map<std::string, formats::PoseFormat> formats{{"tum", formats::PoseFormat::Tum},
+                                                           {"csv", formats::PoseFormat::Csv}};
   cmd->add_option("--format", o->format, "input format (default: by extension)")
       ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
   cmd->add_option("--output-format", o->output_format, "output format (default: by the output's extension, else the input's)")

@@ -14,14 +14,14 @@
 #include "posefair/core/covariant_acceleration.hpp"
 #include "posefair/core/quaternion_spline.hpp"
 #include "posefair/core/sampled_rotation_energy.hpp"
-#include "posefair/drivers/pose_file.hpp"
+#include "posefair/formats/pose_file.hpp"
 
 namespace posefair::tools {
 namespace {
 
 struct SplineCommandOptions {
   std::string input, output;
-  std::optional<drivers::PoseFormat> format;
+  std::optional<formats::PoseFormat> format;
   double rate = 100.0;
   std::optional<int> frames;
   std::optional<double> accuracy;
@@ -72,7 +72,7 @@ int run_spline(SplineCommandOptions o) {
   SplineKeyframes keys;
   try {
     keys = read_keyframes(o.input);
-  } catch (const drivers::PoseFileError& e) {
+  } catch (const formats::PoseFileError& e) {
     std::cerr << "posefair spline: " << e.what() << "\n";
     return e.line() == 0 && keys.time.empty() && e.message().rfind("cannot open", 0) == 0 ? kExitNoInput : kExitDataErr;
   }
@@ -94,12 +94,12 @@ int run_spline(SplineCommandOptions o) {
     poses.time.push_back(t);
     poses.orientation.push_back(to_quat(q.normalized()));
   }
-  const drivers::PoseFormat format =
-      o.format.value_or(drivers::format_from_extension(o.output).value_or(drivers::PoseFormat::Tum));
+  const formats::PoseFormat format =
+      o.format.value_or(formats::format_from_extension(o.output).value_or(formats::PoseFormat::Tum));
   try {
-    const drivers::PoseFile doc = format == drivers::PoseFormat::Csv ? drivers::make_csv(poses) : drivers::make_tum(poses);
-    drivers::write_pose_file(o.output, doc, poses);
-  } catch (const drivers::PoseFileError& e) {
+    const formats::PoseFile doc = format == formats::PoseFormat::Csv ? formats::make_csv(poses) : formats::make_tum(poses);
+    formats::write_pose_file(o.output, doc, poses);
+  } catch (const formats::PoseFileError& e) {
     std::cerr << "posefair spline: " << e.what() << "\n";
     return kExitCantCreate;
   }
@@ -151,7 +151,7 @@ void add_spline_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("spline", "Minimal covariant-acceleration quaternion spline through keyframes (Ramamoorthi & Barr)");
   cmd->add_option("keyframes", o->input, "keyframe file: lines 't w x y z' or TUM lines, optional omega_start/omega_end")->required();
   cmd->add_option("-o,--output", o->output, "sampled curve to write (TUM, or CSV t,qw,qx,qy,qz)")->required();
-  const std::map<std::string, drivers::PoseFormat> formats{{"tum", drivers::PoseFormat::Tum}, {"csv", drivers::PoseFormat::Csv}};
+  const std::map<std::string, formats::PoseFormat> formats{{"tum", formats::PoseFormat::Tum}, {"csv", formats::PoseFormat::Csv}};
   cmd->add_option("--format", o->format, "output format (default: .csv -> csv, else tum)")
       ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
   cmd->add_option("--rate", o->rate, "output samples per second")->check(CLI::Range(1e-6, 1e7))->capture_default_str();

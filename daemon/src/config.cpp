@@ -22,7 +22,7 @@
 #include "posefair/daemon/wire_protocol.hpp"
 #include "posefair/drivers/can_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
-#include "posefair/drivers/pose_file.hpp"
+#include "posefair/formats/pose_file.hpp"
 
 namespace posefair::daemon {
 namespace {
@@ -982,16 +982,16 @@ class Parser {
       if (const toml::node* n = t.get("loop")) o.loop = get_bool(*n, key("loop"));
       if (const toml::node* n = t.get("rounds")) o.max_rounds = static_cast<std::uint64_t>(get_int(*n, key("rounds"), 0, kMaxI64));
       if (const toml::node* n = t.get("format")) {
-        o.pose.format = get_choice<std::optional<drivers::PoseFormat>>(
+        o.pose.format = get_choice<std::optional<formats::PoseFormat>>(
             *n, key("format"),
-            {{"auto", std::nullopt}, {"tum", drivers::PoseFormat::Tum}, {"csv", drivers::PoseFormat::Csv}, {"bvh", drivers::PoseFormat::Bvh}});
+            {{"auto", std::nullopt}, {"tum", formats::PoseFormat::Tum}, {"csv", formats::PoseFormat::Csv}, {"bvh", formats::PoseFormat::Bvh}});
       }
       if (const toml::node* n = t.get("joint")) o.pose.bvh_joint = get_nonempty_string(*n, key("joint"));
       if (const toml::node* n = t.get("csv_prefix")) o.pose.csv_prefix = get_string(*n, key("csv_prefix"));
       if (const toml::node* n = t.get("skip_missing")) o.pose.skip_missing = get_bool(*n, key("skip_missing"));
       if (const toml::node* n = t.get("source_stream")) r.source_stream = get_u32(*n, key("source_stream"));
-      const auto format = o.pose.format ? o.pose.format : drivers::format_from_extension(r.path);
-      if (format == drivers::PoseFormat::Bvh && o.pose.bvh_joint.empty())
+      const auto format = o.pose.format ? o.pose.format : formats::format_from_extension(r.path);
+      if (format == formats::PoseFormat::Bvh && o.pose.bvh_joint.empty())
         fail(t.source().begin, key("joint"), "missing required key (a BVH source plays one joint)");
       return std::nullopt;
     }

@@ -45,7 +45,7 @@ MadeDriver make_candump_replay(const StreamConfig& stream) {
                                ", " + std::to_string(decoded.frame_counters.foreign) + " with other ids, " +
                                std::to_string(decoded.other_interfaces) + " of other interfaces)");
     made.driver = std::make_unique<drivers::ReplayDriver>(std::move(decoded.samples), options, made.source);
-  } catch (const drivers::CandumpFileError& e) {
+  } catch (const formats::CandumpFileError& e) {
     throw std::runtime_error(where + e.what());
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(where + e.what());
@@ -66,7 +66,7 @@ MadeDriver make_replay(const StreamConfig& stream) {
     made.warnings = loaded.warnings();
     // A sample log can hold several streams: keep the one asked for and give it this id.
     std::vector<std::uint32_t> ids;
-    for (const drivers::StreamInfo& info : loaded.streams()) ids.push_back(info.id);
+    for (const formats::StreamInfo& info : loaded.streams()) ids.push_back(info.id);
     std::uint32_t wanted = stream.id;
     if (rc.source_stream) {
       wanted = *rc.source_stream;
@@ -86,9 +86,9 @@ MadeDriver make_replay(const StreamConfig& stream) {
     if (samples.empty()) throw std::runtime_error(where + "no samples of stream " + std::to_string(wanted));
     if (rc.source_stream) made.source += " stream " + std::to_string(wanted);
     made.driver = std::make_unique<drivers::ReplayDriver>(std::move(samples), options, made.source);
-  } catch (const drivers::SampleLogError& e) {
+  } catch (const formats::SampleLogError& e) {
     throw std::runtime_error(where + e.what());
-  } catch (const drivers::PoseFileError& e) {
+  } catch (const formats::PoseFileError& e) {
     throw std::runtime_error(where + e.what());
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(where + e.what());

@@ -117,21 +117,21 @@ Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
     const StreamConfig& sc = config_.streams[i];
     MadeDriver made = make_driver(sc);
     for (std::string& w : made.warnings) warnings_.push_back("stream '" + sc.name + "': " + w);
-    header_.streams.push_back(drivers::StreamInfo{sc.id, sc.name, made.source});
+    header_.streams.push_back(formats::StreamInfo{sc.id, sc.name, made.source});
     streams_.push_back(std::make_unique<Stream>(*this, sc, std::move(made), static_cast<std::uint32_t>(i), record));
     streams_.back()->gpio = make_gpio_lines(sc, *streams_.back());
     ids.push_back(sc.id);
   }
   publisher_ = std::make_unique<Publisher>(session, ids, config_.outputs, first_sequence);
   if (record && !defer_recorder) {
-    drivers::SampleLogWriterOptions wo;
+    formats::SampleLogWriterOptions wo;
     wo.max_file_bytes = config_.recorder.max_file_bytes;
     wo.flush_interval = config_.recorder.flush_interval;
     wo.overwrite = config_.recorder.overwrite;
     wo.sync = config_.recorder.sync;
     try {
-      writer_ = std::make_unique<drivers::SampleLogWriter>(expand_time_pattern(config_.recorder.path), header_, wo);
-    } catch (const drivers::SampleLogError& e) {
+      writer_ = std::make_unique<formats::SampleLogWriter>(expand_time_pattern(config_.recorder.path), header_, wo);
+    } catch (const formats::SampleLogError& e) {
       throw std::runtime_error(std::string("recorder: ") + e.what());
     }
   }
@@ -404,9 +404,9 @@ void Pipeline::continue_sequences(const std::map<std::uint32_t, std::uint64_t>& 
 
 std::map<std::uint32_t, std::uint64_t> Pipeline::next_sequences() const { return final_sequences_; }
 
-std::unique_ptr<drivers::SampleLogWriter> Pipeline::release_recorder() { return std::move(writer_); }
+std::unique_ptr<formats::SampleLogWriter> Pipeline::release_recorder() { return std::move(writer_); }
 
-void Pipeline::adopt_recorder(std::unique_ptr<drivers::SampleLogWriter> writer) {
+void Pipeline::adopt_recorder(std::unique_ptr<formats::SampleLogWriter> writer) {
   if (started_) throw std::logic_error("Pipeline::adopt_recorder after start");
   writer_ = std::move(writer);
 }

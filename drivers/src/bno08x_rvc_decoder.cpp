@@ -46,9 +46,9 @@
 #include <cmath>
 #include <cstring>
 
+#include "posefair/core/euler_angles.hpp"
 #include "posefair/drivers/byte_order.hpp"
 #include "posefair/drivers/checksums.hpp"
-#include "posefair/drivers/euler_angles.hpp"
 #include "frame_feed.hpp"
 
 namespace posefair::drivers {

@@ -37,13 +37,13 @@ class Stamper final : public DecodedSink {
 
 }  // namespace
 
-CandumpReplay decode_candump(const CandumpLog& log, const CandumpReplayOptions& options) {
+CandumpReplay decode_candump(const formats::CandumpLog& log, const CandumpReplayOptions& options) {
   std::unique_ptr<CanDecoder> decoder = make_can_decoder(options.protocol, options.decoder);
   if (!decoder) throw std::invalid_argument("unknown CAN protocol \"" + options.protocol + "\"");
   CandumpReplay r;
   r.problems = log.problems;
   Stamper stamper(options, r.samples);
-  for (const CandumpRecord& rec : log.records) {
+  for (const formats::CandumpRecord& rec : log.records) {
     if (!options.interface.empty() && rec.interface != options.interface) {
       ++r.other_interfaces;
       continue;
@@ -57,7 +57,7 @@ CandumpReplay decode_candump(const CandumpLog& log, const CandumpReplayOptions& 
 }
 
 CandumpReplay decode_candump_file(const std::filesystem::path& path, const CandumpReplayOptions& options) {
-  return decode_candump(read_candump_log(path), options);
+  return decode_candump(formats::read_candump_log(path), options);
 }
 
 }  // namespace posefair::drivers

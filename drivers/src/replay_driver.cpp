@@ -24,10 +24,10 @@ namespace {
 bool starts_with_log_magic(const std::filesystem::path& path) {
   std::FILE* f = std::fopen(path.c_str(), "rbe");
   if (f == nullptr) return false;
-  unsigned char head[sizeof kSampleLogMagic] = {};
+  unsigned char head[sizeof formats::kSampleLogMagic] = {};
   const std::size_t n = std::fread(head, 1, sizeof head, f);
   std::fclose(f);
-  return n == sizeof head && std::memcmp(head, kSampleLogMagic, sizeof head) == 0;
+  return n == sizeof head && std::memcmp(head, formats::kSampleLogMagic, sizeof head) == 0;
 }
 
 // Span + mean spacing of a set of values (the shift per loop round); 1 s when they do not span.
@@ -42,10 +42,10 @@ double loop_period(double lo, double hi, std::size_t n) {
 ReplayDriver::ReplayDriver(const std::filesystem::path& source, ReplayOptions options)
     : options_(std::move(options)), name_("replay:" + source.filename().string()) {
   if (starts_with_log_magic(source) || source.extension() == ".pflog") {
-    SampleLogContents log = options_.follow_rotation ? read_sample_log_set(source) : read_sample_log(source);
+    formats::SampleLogContents log = options_.follow_rotation ? formats::read_sample_log_set(source) : formats::read_sample_log(source);
     samples_ = std::move(log.samples);
     streams_ = std::move(log.header.streams);
-    for (const SampleLogProblem& p : log.stats.problems) {
+    for (const formats::SampleLogProblem& p : log.stats.problems) {
       warnings_.push_back(p.message + " (" + std::to_string(p.unread_bytes) + " bytes not read)");
     }
     if (log.stats.unknown_records > 0) {
@@ -53,7 +53,7 @@ ReplayDriver::ReplayDriver(const std::filesystem::path& source, ReplayOptions op
                           " records of kinds this version does not know were skipped");
     }
   } else {
-    const PoseFile file = read_pose_file(source, options_.pose);
+    const formats::PoseFile file = formats::read_pose_file(source, options_.pose);
     const PoseSequence& poses = file.poses();
     samples_.resize(poses.size());
     for (std::size_t i = 0; i < poses.size(); ++i) {
@@ -67,7 +67,7 @@ ReplayDriver::ReplayDriver(const std::filesystem::path& source, ReplayOptions op
         s.flags |= kHasPosition;
       }
     }
-    streams_.push_back(StreamInfo{options_.stream_id, source.stem().string(),
+    streams_.push_back(formats::StreamInfo{options_.stream_id, source.stem().string(),
                                   "replay of " + source.string() + " (" + std::string(to_string(file.format())) + ")"});
     warnings_ = file.warnings();
     if (file.skipped_rows() > 0) {
@@ -84,7 +84,7 @@ ReplayDriver::ReplayDriver(std::vector<Sample> samples, ReplayOptions options, s
   for (const Sample& s : samples_) {
     if (!seen[s.stream_id]) {
       seen[s.stream_id] = true;
-      streams_.push_back(StreamInfo{s.stream_id, "stream " + std::to_string(s.stream_id), name_});
+      streams_.push_back(formats::StreamInfo{s.stream_id, "stream " + std::to_string(s.stream_id), name_});
     }
   }
   prepare();

@@ -86,9 +86,9 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "posefair/core/euler_angles.hpp"
 #include "posefair/drivers/checksums.hpp"
-#include "posefair/drivers/euler_angles.hpp"
-#include "posefair/drivers/format_detail.hpp"
+#include "posefair/formats/format_detail.hpp"
 
 namespace posefair::drivers {
 
@@ -260,7 +260,7 @@ class VectorNavDecoder final : public Decoder {
       if (stop == std::string_view::npos) stop = body.size();
       const std::string_view f = body.substr(start, stop - start);
       if (count < expected) {
-        const std::optional<double> x = detail::parse_number(f);
+        const std::optional<double> x = formats::detail::parse_number(f);
         if (!x || !std::isfinite(*x) || (strict && !device_number_format(f))) return malformed();
         v[count++] = *x;
       } else if (f.empty() || (f[0] != 'T' && f[0] != 'S') || ++extras > 2) {

@@ -60,9 +60,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "posefair/core/euler_angles.hpp"
 #include "posefair/drivers/byte_order.hpp"
 #include "posefair/drivers/checksums.hpp"
-#include "posefair/drivers/euler_angles.hpp"
 #include "frame_feed.hpp"
 
 namespace posefair::drivers {

@@ -20,7 +20,7 @@
 
 #include "posefair/core/pose_spline.hpp"
 #include "posefair/core/rigid_pose_lerp.hpp"
-#include "posefair/drivers/pose_file.hpp"
+#include "posefair/formats/pose_file.hpp"
 
 namespace {
 
@@ -116,18 +116,18 @@ int main(int argc, char** argv) {
   const std::filesystem::path dir = argc > 1 ? argv[1] : "../shared/data";
   std::vector<Data> sets;
   try {
-    drivers::ReadOptions tum;
-    tum.format = drivers::PoseFormat::Tum;
+    formats::ReadOptions tum;
+    tum.format = formats::PoseFormat::Tum;
     for (const char* f : {"freiburg1_xyz-groundtruth.txt", "fr2_desk_groundtruth.txt", "freiburg1_xyz-rgbdslam.txt", "fr2_desk_ORB.txt"})
-      sets.push_back({std::string("tum/") + f, cleaned(drivers::read_pose_file(dir / "tum" / f, tum).poses())});
-    drivers::ReadOptions broad;
+      sets.push_back({std::string("tum/") + f, cleaned(formats::read_pose_file(dir / "tum" / f, tum).poses())});
+    formats::ReadOptions broad;
     broad.csv_prefix = "gt_";
     broad.skip_missing = true;
     for (const char* f : {"16_undisturbed_fast_translation_B.csv", "21_undisturbed_fast_combined.csv"})
-      sets.push_back({std::string("broad/") + f, cleaned(drivers::read_pose_file(dir / "broad" / f, broad).poses())});
-    drivers::ReadOptions bvh;
+      sets.push_back({std::string("broad/") + f, cleaned(formats::read_pose_file(dir / "broad" / f, broad).poses())});
+    formats::ReadOptions bvh;
     bvh.bvh_joint = "Hips";
-    sets.push_back({"bvh/01_01.bvh Hips", cleaned(drivers::read_pose_file(dir / "bvh" / "01_01.bvh", bvh).poses(), 1)});
+    sets.push_back({"bvh/01_01.bvh Hips", cleaned(formats::read_pose_file(dir / "bvh" / "01_01.bvh", bvh).poses(), 1)});
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pose_interpolation_study: %s\n", e.what());
     return 1;

@@ -160,7 +160,7 @@ TEST(Config, AFullConfigFillsEveryField) {
     EXPECT_TRUE(r.options.loop);
     EXPECT_EQ(r.options.max_rounds, 3u);
     EXPECT_EQ(r.options.stream_id, 7u);
-    EXPECT_EQ(r.options.pose.format, std::optional<drivers::PoseFormat>(drivers::PoseFormat::Csv));
+    EXPECT_EQ(r.options.pose.format, std::optional<formats::PoseFormat>(formats::PoseFormat::Csv));
     EXPECT_EQ(r.options.pose.csv_prefix, std::optional<std::string>("gt_"));
     EXPECT_TRUE(r.options.pose.skip_missing);
     EXPECT_EQ(r.options.pose.bvh_joint, "");

@@ -14,10 +14,10 @@
 #include "../support/daemon_process.hpp"
 #include "../support/test_files.hpp"
 #include "posefair/core/so3.hpp"
-#include "posefair/drivers/candump_log.hpp"
 #include "posefair/drivers/dronecan_ahrs_decoder.hpp"
 #include "posefair/drivers/posefair_can_decoder.hpp"
 #include "posefair/drivers/xsens_can_decoder.hpp"
+#include "posefair/formats/candump_log.hpp"
 
 namespace posefair::testing {
 namespace {
@@ -36,7 +36,7 @@ Quat orientation(int stream, int k) {
 std::string candump_log() {
   std::string log;
   auto add = [&](const std::vector<drivers::CanFrame>& frames, const char* interface) {
-    for (const drivers::CanFrame& f : frames) log += drivers::format_candump_line(f, interface) + "\n";
+    for (const drivers::CanFrame& f : frames) log += formats::format_candump_line(f, interface) + "\n";
   };
   const std::vector<std::uint8_t> no_bytes;
   for (int k = 0; k < kSamples; ++k) {

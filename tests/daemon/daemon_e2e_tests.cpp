@@ -43,8 +43,8 @@
 #include "../support/test_files.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
-#include "posefair/drivers/pose_file.hpp"
-#include "posefair/drivers/sample_log.hpp"
+#include "posefair/formats/pose_file.hpp"
+#include "posefair/formats/sample_log.hpp"
 
 namespace posefair::testing {
 namespace {
@@ -104,12 +104,12 @@ void run_fair_vs_daemon(const EngineCase& c) {
   // Read back as the daemon's replay driver reads a pose file: a value the fair tool left
   // unchanged keeps the file's text, which stands for the (renormalised) value read, and
   // everything else is written as the shortest text of its double, so this is exact.
-  const drivers::PoseFile expected_file = drivers::read_pose_file(fair_csv, {});
+  const formats::PoseFile expected_file = formats::read_pose_file(fair_csv, {});
   const PoseSequence& expected = expected_file.poses();
   ASSERT_EQ(expected.size(), kDemoSamples) << f.out();
   ASSERT_TRUE(expected.has_position());
   // The input as the daemon reads it: a pose equal to its measurement is no evidence of fairing.
-  const PoseSequence input = drivers::read_pose_file(kDemoCsv, {}).poses();
+  const PoseSequence input = formats::read_pose_file(kDemoCsv, {}).poses();
   ASSERT_EQ(input.size(), kDemoSamples);
 
   // posefair sub on a free port, then posefaird replaying the same file with the same engine.
@@ -379,7 +379,7 @@ TEST(DaemonRecording, SigtermWhileRecordingThenReplayTheRecording) {
   EXPECT_EQ(c->recorded, c->received) << c->line;
   EXPECT_EQ(c->record_dropped, 0u) << c->line;
 
-  const drivers::SampleLogContents log = drivers::read_sample_log(recording);
+  const formats::SampleLogContents log = formats::read_sample_log(recording);
   EXPECT_TRUE(log.stats.problems.empty()) << log.stats.problems.front().message;
   ASSERT_EQ(log.header.streams.size(), 1u);
   EXPECT_EQ(log.header.streams[0].id, 3u);
@@ -439,7 +439,7 @@ TEST(DaemonRecording, SighupWithTheSameRecorderContinuesTheRecording) {
     ++lines;
   }
   ASSERT_EQ(lines, 2u) << d.err();
-  const drivers::SampleLogContents log = drivers::read_sample_log(dir / "both.pflog");
+  const formats::SampleLogContents log = formats::read_sample_log(dir / "both.pflog");
   EXPECT_TRUE(log.stats.problems.empty());
   EXPECT_EQ(log.samples.size(), received) << "one file holds every sample of both pipelines";
   EXPECT_FALSE(fs::exists(dir / "both.1.pflog"));
@@ -463,7 +463,7 @@ TEST(DaemonRecording, ATimePatternInTheRecorderPathNamesTheFile) {
   std::strftime(name, sizeof name, "run-%Y%m%d.pflog", &local);
   ASSERT_TRUE(fs::exists(dir / name)) << "expected " << name << "; " << d.err();
   EXPECT_FALSE(fs::exists(dir / "run-%Y%m%d.pflog"));
-  EXPECT_EQ(drivers::read_sample_log(dir / name).samples.size(), 200u);
+  EXPECT_EQ(formats::read_sample_log(dir / name).samples.size(), 200u);
 }
 
 TEST(DaemonRecording, ATruncatedRecordingIsPlayedUpToTheDamageWithAWarning) {
@@ -483,14 +483,14 @@ TEST(DaemonRecording, ATruncatedRecordingIsPlayedUpToTheDamageWithAWarning) {
   ASSERT_TRUE(c) << d.err();
   ASSERT_EQ(c->recorded, kDemoSamples) << c->line;
   {
-    const auto whole = drivers::read_sample_log(recording);
+    const auto whole = formats::read_sample_log(recording);
     ASSERT_TRUE(whole.stats.problems.empty());
     ASSERT_EQ(whole.samples.size(), kDemoSamples);
   }
 
   // Cut off the last 50 bytes: the last record is no longer whole.
   fs::resize_file(recording, fs::file_size(recording) - 50);
-  const auto cut = drivers::read_sample_log(recording);
+  const auto cut = formats::read_sample_log(recording);
   ASSERT_EQ(cut.stats.problems.size(), 1u);
   const std::uint64_t offset = cut.stats.problems[0].offset;
   const std::size_t intact = cut.samples.size();

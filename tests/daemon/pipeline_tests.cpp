@@ -23,7 +23,7 @@
 #include "posefair/daemon/pipeline.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
-#include "posefair/drivers/pose_file.hpp"
+#include "posefair/formats/pose_file.hpp"
 #include "../support/udp_collector.hpp"
 
 namespace posefair::daemon {
@@ -68,7 +68,7 @@ std::string replay_config(std::uint16_t port, std::uint32_t ring_capacity, const
 }
 
 std::vector<double> demo_times() {
-  const drivers::PoseFile f = drivers::read_pose_file(kDemoCsv, {});
+  const formats::PoseFile f = formats::read_pose_file(kDemoCsv, {});
   return f.poses().time;
 }
 

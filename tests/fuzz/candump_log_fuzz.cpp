@@ -1,14 +1,14 @@
-// Fuzz target: the candump log parser (drivers/src/candump_log.cpp). The input is the file's
+// Fuzz target: the candump log parser (formats/src/candump_log.cpp). The input is the file's
 // text. Every line is either a record or a problem (blank lines neither), line numbers rise,
 // lengths fit the frame kind, and every record written back with format_candump_line parses to
 // the same frame. abort() otherwise.
 #include <cstdlib>
 #include <string_view>
 
-#include "posefair/drivers/candump_log.hpp"
+#include "posefair/formats/candump_log.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  using namespace posefair::drivers;
+  using namespace posefair::formats;
   const CandumpLog log = parse_candump_log({reinterpret_cast<const char*>(data), size});
   if (log.records.size() + log.problems.size() > log.lines) std::abort();
   std::size_t last = 0;

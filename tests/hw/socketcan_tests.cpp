@@ -36,11 +36,11 @@
 #include "../support/daemon_process.hpp"
 #include "../support/test_files.hpp"
 #include "posefair/core/so3.hpp"
-#include "posefair/drivers/candump_log.hpp"
 #include "posefair/drivers/dronecan_ahrs_decoder.hpp"
 #include "posefair/drivers/posefair_can_decoder.hpp"
 #include "posefair/drivers/socketcan_driver.hpp"
 #include "posefair/drivers/xsens_can_decoder.hpp"
+#include "posefair/formats/candump_log.hpp"
 
 namespace posefair::testing {
 namespace {
@@ -460,7 +460,7 @@ Quat stream_orientation(int stream, int k) {
 
 // "123#11223344" from a frame (can-utils' compact form, as cansend takes it).
 std::string compact(const CanFrame& f) {
-  const std::string line = drivers::format_candump_line(f, "x");
+  const std::string line = formats::format_candump_line(f, "x");
   return line.substr(line.rfind(' ') + 1);
 }
 
@@ -499,7 +499,7 @@ TEST(SocketCanDaemon, CansendCanplayerAndPythonCanFramesArePublishedAsPoses) {
   for (int k = 0; k < kPeerSamples; ++k)
     for (const CanFrame& f : drivers::encode_xsens_can(stream_orientation(2, k), 100u * static_cast<std::uint32_t>(k),
                                                        static_cast<std::uint16_t>(k), (t += 0.001)))
-      log += drivers::format_candump_line(f, bus.name()) + "\n";
+      log += formats::format_candump_line(f, bus.name()) + "\n";
   write_text(dir / "mti.log", log);
   ASSERT_EQ(sh("/usr/bin/canplayer -I " + (dir / "mti.log").string()), 0);
   // dronecan-ahrs with python-can: multi-frame transfers, the frames listed in a file.

@@ -13,14 +13,14 @@
 #include <string>
 #include <vector>
 
+#include "posefair/core/euler_angles.hpp"
 #include "posefair/drivers/bno08x_rvc_decoder.hpp"
-#include "posefair/drivers/euler_angles.hpp"
-#include "posefair/drivers/pose_file.hpp"
 #include "posefair/drivers/posefair_serial_decoder.hpp"
 #include "posefair/drivers/vectornav_decoder.hpp"
 #include "posefair/drivers/witmotion_decoder.hpp"
 #include "posefair/drivers/xsens_decoder.hpp"
 #include "posefair/drivers/yost_decoder.hpp"
+#include "posefair/formats/pose_file.hpp"
 
 namespace {
 
@@ -45,7 +45,7 @@ std::string text(const Bytes& b) {
 
 // Yaw, pitch, roll (Z-Y-X, degrees) of q, as the Euler-angle devices report them.
 std::array<double, 3> ypr(const Quat& q) {
-  return drv::quat_to_euler_nearest(q, {drv::Axis::Z, drv::Axis::Y, drv::Axis::X}, {0.0, 0.0, 0.0});
+  return posefair::quat_to_euler_nearest(q, {posefair::Axis::Z, posefair::Axis::Y, posefair::Axis::X}, {0.0, 0.0, 0.0});
 }
 
 // What a UART at rx_baud reads from bytes sent at tx_baud (8N1, LSB first): a receiver finds
@@ -154,9 +154,9 @@ int main(int argc, char** argv) {
     return 64;
   }
   try {
-    drv::ReadOptions ro;
+    posefair::formats::ReadOptions ro;
     ro.csv_prefix = "gt_";
-    const posefair::PoseSequence seq = drv::read_pose_file(argv[1], ro).poses();
+    const posefair::PoseSequence seq = posefair::formats::read_pose_file(argv[1], ro).poses();
     std::vector<Motion> motion;
     for (std::size_t i = 0; i < kFrames; ++i) {
       const std::size_t k = i * kStride;

@@ -16,16 +16,16 @@
 #include <vector>
 
 #include "posefair/drivers/replay_driver.hpp"
-#include "posefair/drivers/sample_log.hpp"
-#include "replaylog_test_support.hpp"
+#include "posefair/formats/sample_log.hpp"
+#include "../formats/sample_log_test_support.hpp"
 
 namespace posefair::drivers {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::bit_identical;
-using testing::make_samples;
-using testing::ScratchDir;
+using formats::testing::bit_identical;
+using formats::testing::make_samples;
+using formats::testing::ScratchDir;
 
 double monotonic_now() {
   timespec ts{};
@@ -76,11 +76,11 @@ std::vector<Sample> evenly(std::size_t n, double dt, std::uint32_t stream = 1, s
   return out;
 }
 
-void write_log(const fs::path& path, const std::vector<Sample>& samples, SampleLogWriterOptions o = {}) {
-  SampleLogHeader h;
+void write_log(const fs::path& path, const std::vector<Sample>& samples, formats::SampleLogWriterOptions o = {}) {
+  formats::SampleLogHeader h;
   h.streams = {{10, "a", "test"}, {11, "b", "test"}, {12, "c", "test"}};
   o.sync = false;
-  SampleLogWriter w(path, h, o);
+  formats::SampleLogWriter w(path, h, o);
   for (const Sample& s : samples) w.append(s);
 }
 
@@ -246,7 +246,7 @@ TEST(ReplayDriver, TumFileAsFastAsPossible) {
   driver.run(std::stop_token{}, sink);
   ASSERT_EQ(sink.samples.size(), 2893u);
   EXPECT_EQ(driver.delivered(), 2893u);
-  const PoseFile file = read_pose_file(tum, {});
+  const formats::PoseFile file = formats::read_pose_file(tum, {});
   for (std::size_t i = 0; i < sink.samples.size(); ++i) {
     const Sample& s = sink.samples[i];
     ASSERT_EQ(s.stream_id, 5u);
@@ -283,10 +283,10 @@ TEST(ReplayDriver, CsvFileGetsTheStreamIdAndNoPositionsWhenItHasNone) {
 TEST(ReplayDriver, ARotatedLogPlaysAllItsParts) {
   ScratchDir dir;
   const std::vector<Sample> recorded = make_samples(95);
-  SampleLogWriterOptions o;
+  formats::SampleLogWriterOptions o;
   o.max_file_bytes = 2000;
   write_log(dir / "run.pflog", recorded, o);
-  ASSERT_GT(sample_log_files(dir / "run.pflog").size(), 3u);
+  ASSERT_GT(formats::sample_log_files(dir / "run.pflog").size(), 3u);
   ReplayDriver all(dir / "run.pflog", fast());
   EXPECT_EQ(all.samples().size(), 95u);
   ReplayOptions first_only = fast();
@@ -314,8 +314,8 @@ TEST(ReplayDriver, BadOptionsAndSourcesThrow) {
   EXPECT_THROW(ReplayDriver(evenly(3, 0.01), o), std::invalid_argument);
   o.speed = std::numeric_limits<double>::infinity();
   EXPECT_THROW(ReplayDriver(evenly(3, 0.01), o), std::invalid_argument);
-  EXPECT_THROW(ReplayDriver(fs::path("/nonexistent/run.pflog")), SampleLogError);
-  EXPECT_THROW(ReplayDriver(fs::path("/nonexistent/run.txt")), PoseFileError);
+  EXPECT_THROW(ReplayDriver(fs::path("/nonexistent/run.pflog")), formats::SampleLogError);
+  EXPECT_THROW(ReplayDriver(fs::path("/nonexistent/run.txt")), formats::PoseFileError);
   ReplayDriver empty(std::vector<Sample>{}, {});
   CollectingSink sink;
   empty.run(std::stop_token{}, sink);

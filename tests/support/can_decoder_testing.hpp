@@ -10,6 +10,7 @@
 
 #include "can_decoder_feed.hpp"
 #include "decoder_testing.hpp"
+#include "random_can_frames.hpp"
 
 namespace posefair::testing {
 
@@ -20,21 +21,7 @@ inline void expect_same(const CanDecoded& a, const CanDecoded& b, const std::str
   for (std::size_t i = 0; i < a.samples.size(); ++i) EXPECT_TRUE(same(a.samples[i], b.samples[i])) << what << " sample " << i;
 }
 
-// `count` frames with identifiers drawn from `ids` (can_id values), random classic lengths
-// 0..8 and random payload bytes, timestamps 1 ms apart.
-inline std::vector<drivers::CanFrame> random_frames(std::size_t count, const std::vector<std::uint32_t>& ids, std::mt19937_64& rng) {
-  std::vector<drivers::CanFrame> frames(count);
-  std::uniform_int_distribution<std::size_t> pick(0, ids.size() - 1);
-  for (std::size_t k = 0; k < count; ++k) {
-    drivers::CanFrame& f = frames[k];
-    f.can_id = ids[pick(rng)];
-    f.len = static_cast<std::uint8_t>(rng() % 9);
-    const std::uint64_t r = rng();
-    for (std::size_t b = 0; b < 8; ++b) f.data[b] = static_cast<std::uint8_t>(r >> (8 * b));
-    f.timestamp = 1e-3 * static_cast<double>(k);
-  }
-  return frames;
-}
+// random_frames(count, ids, rng): random_can_frames.hpp.
 
 // Sum of the payload lengths.
 inline std::uint64_t payload_bytes(const std::vector<drivers::CanFrame>& frames) {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "decoder_feed.hpp"
+#include "hex_bytes.hpp"
 
 namespace posefair::testing {
 
@@ -153,25 +154,7 @@ inline void expect_unit_quaternions(const std::vector<drivers::DecodedSample>& s
 
 // ---- bytes and orientations ----
 
-// The bytes written in hex digits; any other character (spaces) is skipped.
-inline std::vector<std::uint8_t> hex(std::string_view text) {
-  std::vector<std::uint8_t> out;
-  int hi = -1;
-  for (const char c : text) {
-    int v = -1;
-    if (c >= '0' && c <= '9') v = c - '0';
-    if (c >= 'a' && c <= 'f') v = c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') v = c - 'A' + 10;
-    if (v < 0) continue;
-    if (hi < 0) {
-      hi = v;
-    } else {
-      out.push_back(static_cast<std::uint8_t>(hi << 4 | v));
-      hi = -1;
-    }
-  }
-  return out;
-}
+// hex("FF 7F 00"): hex_bytes.hpp.
 
 // The parts one after the other.
 inline std::vector<std::uint8_t> cat(std::initializer_list<std::vector<std::uint8_t>> parts) {

@@ -7,7 +7,7 @@
 #include "posefair/core/causal_fairing.hpp"
 #include "posefair/core/fairing_window.hpp"
 #include "posefair/core/synthetic_motion.hpp"
-#include "posefair/drivers/pose_file.hpp"
+#include "posefair/formats/pose_file.hpp"
 
 namespace posefair {
 namespace {
@@ -64,15 +64,15 @@ TEST(CausalCommand, EqualsTheEngineCalledDirectly) {
       ScratchDir dir;
       const PoseSequence in = noisy(with_position);
       const auto in_path = dir / "in.csv";
-      drivers::write_pose_file(in_path, drivers::make_csv(in), in);
+      formats::write_pose_file(in_path, formats::make_csv(in), in);
       const auto out_path = dir / "out.csv";
       const auto r = run_posefair("fair --causal '" + in_path.string() + "' -o '" + out_path.string() + "' " + c.options, dir);
       ASSERT_EQ(r.exit_code, 0) << r.err << c.options;
       EXPECT_THAT(r.out, HasSubstr("400 emitted"));
       // The file as the CLI read it (values round-trip exactly), through the engine directly.
-      const PoseSequence read_back = drivers::read_pose_file(in_path, {}).poses();
+      const PoseSequence read_back = formats::read_pose_file(in_path, {}).poses();
       const CausalResult direct = fair_causal(read_back, c.config);
-      const PoseSequence cli = drivers::read_pose_file(out_path, {}).poses();
+      const PoseSequence cli = formats::read_pose_file(out_path, {}).poses();
       ASSERT_EQ(cli.size(), direct.poses.size());
       for (std::size_t i = 0; i < cli.size(); ++i) {
         ASSERT_EQ(cli.orientation[i].coeffs(), direct.poses.orientation[i].coeffs()) << c.options << " sample " << i;
@@ -88,7 +88,7 @@ TEST(CausalCommand, CutoffNeedsTheFileRateAndWindowOptionsNeedCausal) {
   ScratchDir dir;
   const PoseSequence in = noisy(false);
   const auto in_path = dir / "in.csv";
-  drivers::write_pose_file(in_path, drivers::make_csv(in), in);
+  formats::write_pose_file(in_path, formats::make_csv(in), in);
   auto r = run_posefair("fair --causal '" + in_path.string() + "' -o '" + (dir / "o.csv").string() + "' --cutoff 80", dir);
   EXPECT_EQ(r.exit_code, 64);  // 80 Hz is above half the 100 Hz rate
   EXPECT_THAT(r.err, HasSubstr("cutoff"));

@@ -8,7 +8,7 @@
 
 #include "cli_runner.hpp"
 #include "posefair/core/synthetic_motion.hpp"
-#include "posefair/drivers/pose_file.hpp"
+#include "posefair/formats/pose_file.hpp"
 
 namespace posefair {
 namespace {
@@ -25,7 +25,7 @@ std::filesystem::path noisy_tum(const ScratchDir& dir) {
   spec.position_noise = 0.01;
   const auto motion = make_synthetic_motion(spec);
   const auto path = dir / "noisy.txt";
-  drivers::write_pose_file(path, drivers::make_tum(motion.noisy), motion.noisy);
+  formats::write_pose_file(path, formats::make_tum(motion.noisy), motion.noisy);
   return path;
 }
 
@@ -40,8 +40,8 @@ TEST(FairCommand, TumRoundTripStaysWithinTheBounds) {
   EXPECT_THAT(r.out, HasSubstr("100 samples"));
   EXPECT_THAT(r.out, HasSubstr("deviation bound"));
   EXPECT_THAT(r.out, HasSubstr("energy"));
-  const auto a = drivers::read_pose_file(in, {}).poses();
-  const auto b = drivers::read_pose_file(out, {}).poses();
+  const auto a = formats::read_pose_file(in, {}).poses();
+  const auto b = formats::read_pose_file(out, {}).poses();
   ASSERT_EQ(a.size(), b.size());
   EXPECT_EQ(a.time, b.time);
   double moved = 0.0;
@@ -89,12 +89,12 @@ TEST(FairCommand, BvhJointIsFairedAndTheRestKept) {
   const auto out = dir / "out.bvh";
   const auto r = run_posefair("fair '" + in.string() + "' -o '" + out.string() + "' --joint Chest --iterations 30", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  drivers::ReadOptions ro;
+  formats::ReadOptions ro;
   ro.bvh_joint = "Hips";
-  const auto hips_in = drivers::read_pose_file(in, ro).poses(), hips_out = drivers::read_pose_file(out, ro).poses();
+  const auto hips_in = formats::read_pose_file(in, ro).poses(), hips_out = formats::read_pose_file(out, ro).poses();
   for (std::size_t i = 0; i < hips_in.size(); ++i) EXPECT_LT(so3::dist(hips_in.orientation[i], hips_out.orientation[i]), 1e-12);
   ro.bvh_joint = "Chest";
-  const auto chest_in = drivers::read_pose_file(in, ro).poses(), chest_out = drivers::read_pose_file(out, ro).poses();
+  const auto chest_in = formats::read_pose_file(in, ro).poses(), chest_out = formats::read_pose_file(out, ro).poses();
   double moved = 0.0;
   for (std::size_t i = 0; i < chest_in.size(); ++i) moved = std::max(moved, so3::dist(chest_in.orientation[i], chest_out.orientation[i]));
   EXPECT_GT(moved, 1e-3);
@@ -171,8 +171,8 @@ TEST(FairCommand, TheDemoRecordingFairsWithinItsBound) {
   const auto r = run_posefair("fair '" + in + "' -o '" + out.string() + "' --eps-r 0.02 --eps-t 0.002", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("2000 samples"));
-  const auto a = drivers::read_pose_file(in, {}).poses();
-  const auto b = drivers::read_pose_file(out, {}).poses();
+  const auto a = formats::read_pose_file(in, {}).poses();
+  const auto b = formats::read_pose_file(out, {}).poses();
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) ASSERT_LT(so3::rotation_angle(a.orientation[i], b.orientation[i]), 0.02);
 }

@@ -10,7 +10,7 @@
 
 #include "cli_runner.hpp"
 #include "posefair/core/pose_spline.hpp"
-#include "posefair/drivers/pose_file.hpp"
+#include "posefair/formats/pose_file.hpp"
 
 namespace posefair {
 namespace {
@@ -46,8 +46,8 @@ TEST(ResampleCommand, RateResamplingKeepsTheKnotsAndMatchesTheLibrary) {
   EXPECT_THAT(r.out, HasSubstr("41 samples"));
   EXPECT_THAT(r.out, HasSubstr("k=3"));
   EXPECT_THAT(r.out, HasSubstr("SO(3)"));
-  const PoseSequence a = drivers::read_pose_file(in, {}).poses();
-  const PoseSequence b = drivers::read_pose_file(out, {}).poses();
+  const PoseSequence a = formats::read_pose_file(in, {}).poses();
+  const PoseSequence b = formats::read_pose_file(out, {}).poses();
   ASSERT_EQ(b.size(), 201u);  // 2 s at 100 Hz, both ends included
   EXPECT_DOUBLE_EQ(b.time.front(), 100.0);
   EXPECT_NEAR(b.time.back(), 102.0, 1e-9);
@@ -78,7 +78,7 @@ TEST(ResampleCommand, TimesFileCsvOutputAndDerivatives) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string written = testing::slurp(out);
   EXPECT_EQ(written.substr(0, written.find('\n')), "t,qw,qx,qy,qz,px,py,pz");
-  const PoseSequence b = drivers::read_pose_file(out, {}).poses();
+  const PoseSequence b = formats::read_pose_file(out, {}).poses();
   ASSERT_EQ(b.size(), 3u);
   EXPECT_DOUBLE_EQ(b.time[2], 101.25);
   const std::string d = testing::slurp(deriv);
@@ -125,8 +125,8 @@ TEST(ResampleCommand, BadInputGetsClearErrorsAndSysexitsCodes) {
   EXPECT_THAT(r.err, HasSubstr(times.string() + ":3: time 102.5 is outside"));
   r = run_posefair("resample " + q(in) + " -o " + q(out) + " --times " + q(times) + " --clamp", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const PoseSequence clamped = drivers::read_pose_file(out, {}).poses();
-  const PoseSequence data = drivers::read_pose_file(in, {}).poses();
+  const PoseSequence clamped = formats::read_pose_file(out, {}).poses();
+  const PoseSequence data = formats::read_pose_file(in, {}).poses();
   EXPECT_DOUBLE_EQ(clamped.time[1], 102.5);
   EXPECT_LT(so3::rotation_angle(clamped.orientation[1], data.orientation.back()), 1e-12);
   // Bad times files.

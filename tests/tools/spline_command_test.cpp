@@ -9,7 +9,7 @@
 
 #include "cli_runner.hpp"
 #include "posefair/core/quaternion_spline_example.hpp"
-#include "posefair/drivers/pose_file.hpp"
+#include "posefair/formats/pose_file.hpp"
 
 namespace posefair {
 namespace {
@@ -28,7 +28,7 @@ TEST(QuaternionSplineCommand, ExampleFileIsTheCoreExample) {
   const auto r = run_posefair("spline '" + kExample + "' -o " + q(out) + " --frames 0 --rate 1", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const SplineKeyframes k = seven_keyframe_example();
-  const PoseSequence s = drivers::read_pose_file(out, {}).poses();
+  const PoseSequence s = formats::read_pose_file(out, {}).poses();
   ASSERT_EQ(s.size(), 7u);  // one sample per second: exactly the keyframes
   for (std::size_t i = 0; i < 7; ++i) {
     EXPECT_DOUBLE_EQ(s.time[i], k.time[i]);
@@ -49,7 +49,7 @@ TEST(QuaternionSplineCommand, WritesTheSampledCurveAndReportsTheStages) {
   EXPECT_THAT(r.err, HasSubstr("ms"));
   EXPECT_THAT(r.err, HasSubstr("raw max"));
   EXPECT_THAT(r.err, HasSubstr("slerp chain"));
-  const PoseSequence s = drivers::read_pose_file(out, {}).poses();
+  const PoseSequence s = formats::read_pose_file(out, {}).poses();
   ASSERT_EQ(s.size(), 301u);  // 6 s at 50 Hz, both ends included
   const SplineKeyframes k = seven_keyframe_example();
   for (std::size_t i = 0; i < s.size(); ++i) {
@@ -86,7 +86,7 @@ TEST(QuaternionSplineCommand, CsvOutputTumInputAndEndVelocities) {
   EXPECT_THAT(r.err, HasSubstr("free/given"));
   const std::string text = testing::slurp(out);
   EXPECT_EQ(text.substr(0, text.find('\n')), "t,qw,qx,qy,qz");
-  const PoseSequence s = drivers::read_pose_file(out, {}).poses();
+  const PoseSequence s = formats::read_pose_file(out, {}).poses();
   ASSERT_EQ(s.size(), 16u);
   EXPECT_LT(so3::rotation_angle(s.orientation[5], Quat(0.968912421711, 0.247403959255, 0, 0)), 1e-9);
 }

@@ -21,7 +21,7 @@
 #include "posefair/daemon/config.hpp"
 #include "posefair/daemon/stream_counters.hpp"
 #include "posefair/daemon/wake_signal.hpp"
-#include "posefair/drivers/sample_log.hpp"
+#include "posefair/formats/sample_log.hpp"
 
 namespace posefair::daemon {
 
@@ -69,12 +69,12 @@ class Pipeline {
   // Accepted damage in replay sources etc., to be logged once by the caller.
   const std::vector<std::string>& warnings() const { return warnings_; }
   // The recording's header (stream table) this pipeline writes or would write.
-  const drivers::SampleLogHeader& recording_header() const { return header_; }
+  const formats::SampleLogHeader& recording_header() const { return header_; }
   // Recorder hand-over at a reload that leaves the recording unchanged: the old pipeline,
   // stopped with keep_recorder, releases its writer; the new one, built with defer_recorder,
   // adopts it before start().
-  std::unique_ptr<drivers::SampleLogWriter> release_recorder();
-  void adopt_recorder(std::unique_ptr<drivers::SampleLogWriter> writer);
+  std::unique_ptr<formats::SampleLogWriter> release_recorder();
+  void adopt_recorder(std::unique_ptr<formats::SampleLogWriter> writer);
   // The same recording (config and stream table): a reload may hand the writer over.
   bool same_recording(const Pipeline& other) const;
 
@@ -94,9 +94,9 @@ class Pipeline {
   PipelineHooks hooks_;
   std::vector<std::unique_ptr<Stream>> streams_;
   std::vector<std::string> warnings_;
-  drivers::SampleLogHeader header_;
+  formats::SampleLogHeader header_;
   std::unique_ptr<class Publisher> publisher_;
-  std::unique_ptr<drivers::SampleLogWriter> writer_;
+  std::unique_ptr<formats::SampleLogWriter> writer_;
   std::map<std::uint32_t, std::uint64_t> final_sequences_;
 
   WakeSignal engine_wake_;

@@ -27,10 +27,14 @@
 #include <string_view>
 #include <vector>
 
-#include "posefair/drivers/can_frame.hpp"
 #include "posefair/drivers/decoder.hpp"
+#include "posefair/formats/can_frame.hpp"
 
 namespace posefair::drivers {
+
+// The frame value lives in formats (candump logs hold frames too); the decoders name it as theirs.
+using formats::CanFrame;
+using formats::valid_fd_length;
 
 // A kernel receive filter, as struct can_filter (linux/can.h): a frame passes when
 // (frame.can_id & mask) == (id & mask). id and mask include the canid_t flags, so a filter can

@@ -11,8 +11,8 @@
 
 #include "posefair/core/sample.hpp"
 #include "posefair/drivers/can_decoder.hpp"
-#include "posefair/drivers/candump_log.hpp"
 #include "posefair/drivers/time_base.hpp"
+#include "posefair/formats/candump_log.hpp"
 
 namespace posefair::drivers {
 
@@ -29,12 +29,12 @@ struct CandumpReplay {
   std::vector<Sample> samples;  // sequence 0, 1, ... in bus order; receive_time = logged time
   DecoderCounters counters;
   CanFrameCounters frame_counters;
-  std::vector<CandumpProblem> problems;  // malformed log lines (skipped)
+  std::vector<formats::CandumpProblem> problems;  // malformed log lines (skipped)
   std::size_t other_interfaces = 0;      // frames skipped for their interface
 };
 
 // Decodes a parsed log. Throws std::invalid_argument for an unknown protocol or a bad option.
-CandumpReplay decode_candump(const CandumpLog& log, const CandumpReplayOptions& options);
+CandumpReplay decode_candump(const formats::CandumpLog& log, const CandumpReplayOptions& options);
 // Reads and decodes a file. Throws CandumpFileError when it cannot be read, std::invalid_argument as above.
 CandumpReplay decode_candump_file(const std::filesystem::path& path, const CandumpReplayOptions& options);
 

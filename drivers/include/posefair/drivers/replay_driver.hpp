@@ -13,8 +13,8 @@
 
 #include "posefair/core/sample.hpp"
 #include "posefair/drivers/driver.hpp"
-#include "posefair/drivers/pose_file.hpp"
-#include "posefair/drivers/sample_log.hpp"
+#include "posefair/formats/pose_file.hpp"
+#include "posefair/formats/sample_log.hpp"
 
 namespace posefair::drivers {
 
@@ -42,7 +42,7 @@ struct ReplayOptions {
   std::uint64_t max_rounds = 0;  // with loop: stop after this many rounds; 0 = until stopped
   // Pose files: the stream id every sample gets (sequence numbers are 0, 1, ... in file order).
   std::uint32_t stream_id = 0;
-  ReadOptions pose;  // pose files: format (else by extension), BVH joint, CSV options
+  formats::ReadOptions pose;  // pose files: format (else by extension), BVH joint, CSV options
   // Sample logs: also play "<base>.1.pflog", "<base>.2.pflog" ... after the file given.
   bool follow_rotation = true;
 };
@@ -74,7 +74,7 @@ class ReplayDriver final : public Driver {
   // The recording as loaded (one round, before any re-basing).
   const std::vector<Sample>& samples() const { return samples_; }
   // The log's stream table; for a pose file one stream (stream_id, the file's stem, "replay of <path>").
-  const std::vector<StreamInfo>& streams() const { return streams_; }
+  const std::vector<formats::StreamInfo>& streams() const { return streams_; }
   // What was accepted while loading: log damage (the problem messages), pose file quirks.
   const std::vector<std::string>& warnings() const { return warnings_; }
   const ReplayOptions& options() const { return options_; }
@@ -85,7 +85,7 @@ class ReplayDriver final : public Driver {
   ReplayOptions options_;
   std::string name_;
   std::vector<Sample> samples_;
-  std::vector<StreamInfo> streams_;
+  std::vector<formats::StreamInfo> streams_;
   std::vector<std::string> warnings_;
   std::vector<double> due_;                 // seconds after the first sample, at speed 1
   std::vector<std::uint64_t> sequence_step_;  // per sample: its stream's sequence shift per round
