@@ -707,7 +707,7 @@ class Parser {
       case OptionType::String:
         if (!spec.choices.empty()) return get_string_choice(n, key, spec.choices);
         return get_nonempty_string(n, key);
-      case OptionType::IntegerOrString:  // a number either way (yost_header = 0x4F, posefair_base_id = "0x204")
+      case OptionType::IntegerOrString:  // a number written either way: 0x4F or "0x4F"
         if (n.is_integer()) return std::to_string(n.as_integer()->get());
         return get_nonempty_string(n, key);
       case OptionType::Integer:

@@ -174,7 +174,7 @@ constexpr OptionSpec kOptions[] = {
     {"value_type", OptionType::String, "int16", "the type of the four values", kValueTypes},
     {"byte_order", OptionType::String, "little", "the values' byte order", kByteOrders},
     {"offsets", OptionType::IntegerArray, "", "the four values' byte offsets after the ID byte, in report order (or offsets_bits)"},
-    {"offsets_bits", OptionType::IntegerArray, "", "the same in bits, for values not on byte boundaries (little-endian only)"},
+    {"offsets_bits", OptionType::IntegerArray, "", "the same in bits (little-endian values may start at any bit)"},
     {"order", OptionType::String, "w-first", "w-first (w x y z) or w-last (x y z w)", kOrders},
     {"scale", OptionType::Float, "0.00006103515625", "value = raw * scale (the default 1/16384 is Q14)"},
 };
