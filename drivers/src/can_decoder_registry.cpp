@@ -1,7 +1,6 @@
 // The CAN decoder registry: one line per protocol (can_decoder.hpp), as decoder_registry.cpp
 // is for the serial ones. A new protocol is one <protocol>_decoder.cpp (with its CanDecoderEntry) plus one line here.
 #include <algorithm>
-#include <array>
 #include <charconv>
 #include <stdexcept>
 #include <string>
@@ -15,7 +14,7 @@ namespace posefair::drivers {
 namespace {
 
 // Sorted by name.
-const std::array<const CanDecoderEntry*, 3> kCanDecoders = {
+const CanDecoderEntry* const kCanDecoders[] = {
     &kDroneCanAhrsDecoder,
     &kPosefairCanDecoder,
     &kXsensCanDecoder,

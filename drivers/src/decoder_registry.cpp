@@ -1,7 +1,6 @@
 // The decoder registry: one line per protocol (decoder.hpp), in the manner of gpsd's driver
 // table. A new protocol is one <protocol>_decoder.cpp (with its DecoderEntry) plus one line here.
 #include <algorithm>
-#include <array>
 
 #include "posefair/drivers/bno08x_rvc_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
@@ -15,7 +14,7 @@ namespace posefair::drivers {
 namespace {
 
 // Sorted by name.
-const std::array<const DecoderEntry*, 6> kDecoders = {
+const DecoderEntry* const kDecoders[] = {
     &kBno08xRvcDecoder,
     &kPosefairSerialDecoder,
     &kVectorNavDecoder,

@@ -2,7 +2,6 @@
 // decoder_registry.cpp is for the serial ones. A new protocol is one <protocol>_decoder.cpp
 // (with its HidDecoderEntry) plus one line here.
 #include <algorithm>
-#include <array>
 
 #include "posefair/drivers/hid_report_decoder.hpp"
 #include "posefair/drivers/hid_sensor_orientation_decoder.hpp"
@@ -12,7 +11,7 @@ namespace posefair::drivers {
 namespace {
 
 // Sorted by name.
-const std::array<const HidDecoderEntry*, 2> kHidDecoders = {
+const HidDecoderEntry* const kHidDecoders[] = {
     &kHidSensorDecoder,
     &kHidVendorDecoder,
 };
