@@ -4,10 +4,14 @@
 #include <array>
 #include <cstdio>
 #include <iostream>
+#include <span>
+#include <string_view>
 #include <stdexcept>
 
 #include "exit_codes.hpp"
+#include "posefair/drivers/can_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
+#include "posefair/drivers/hid_report_decoder.hpp"
 
 namespace posefair::tools {
 namespace {
@@ -22,7 +26,29 @@ std::string description(const drivers::PortInfo& p) {
   return or_dash(d);
 }
 
+// One registry's protocols: name, description, and each option with its type and default.
+template <class Entry>
+std::string format_registry(std::string_view title, std::span<const Entry* const> entries) {
+  std::string out = "\n" + std::string(title) + ":\n";
+  for (const Entry* e : entries) {
+    out += "  " + std::string(e->name) + ": " + std::string(e->description) + "\n";
+    for (const drivers::OptionSpec& o : e->options) {
+      out += "    " + std::string(o.name) + " (" + std::string(drivers::to_string(o.type));
+      if (!o.default_value.empty()) out += ", default " + std::string(o.default_value);
+      for (std::size_t c = 0; c < o.choices.size(); ++c) out += (c == 0 ? ", one of " : "|") + std::string(o.choices[c]);
+      out += "): " + std::string(o.doc) + "\n";
+    }
+  }
+  return out;
+}
+
 }  // namespace
+
+std::string format_protocols() {
+  return format_registry("serial protocols (type = \"serial\")", drivers::decoder_entries()) +
+         format_registry("CAN protocols (type = \"socketcan\", or a candump replay)", drivers::can_decoder_entries()) +
+         format_registry("HID protocols (type = \"hid\")", drivers::hid_decoder_entries());
+}
 
 std::string format_devices(const std::vector<drivers::PortInfo>& ports, const std::vector<std::string>& protocols) {
   std::string out;
@@ -54,14 +80,14 @@ std::string format_devices(const std::vector<drivers::PortInfo>& ports, const st
 
 void add_devices_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("devices",
-                                 "List serial ports (path, USB VID:PID, serial number) and the known device protocols");
+                                 "List serial ports (path, USB VID:PID, serial number) and the known device protocols with their options");
   cmd->footer(
       "A [stream.driver] with type = \"serial\" names a port by device = \"/dev/...\" (a /dev/serial/by-id/ link "
       "survives replugging) or by usb = \"VID:PID\" with serial_number to choose among equal devices; protocol is one "
       "of the protocols listed (docs/config.md). Pseudo-terminals are not listed.");
   cmd->callback([&exit_code] {
     try {
-      std::cout << format_devices(drivers::list_serial_ports(), drivers::decoder_protocols());
+      std::cout << format_devices(drivers::list_serial_ports(), drivers::decoder_protocols()) << format_protocols();
       exit_code = kExitOk;
     } catch (const std::runtime_error& e) {
       std::cerr << "posefair devices: " << e.what() << "\n";

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <initializer_list>
 #include <limits>
@@ -22,6 +23,8 @@
 #include "posefair/daemon/wire_protocol.hpp"
 #include "posefair/drivers/can_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
+#include "posefair/drivers/device_options.hpp"
+#include "posefair/drivers/hid_report_decoder.hpp"
 #include "posefair/formats/pose_file.hpp"
 
 namespace posefair::daemon {
@@ -133,77 +136,116 @@ constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "over
 constexpr std::string_view kGpioKeys[] = {"chip",          "data_ready_line", "edge",        "bias",        "tolerance_min",
                                           "tolerance_max", "output_line",     "output_mode", "heartbeat_hz"};
 constexpr std::string_view kSplineKeys[] = {"publish_rate_hz", "bridge_gap", "order", "manifold", "velocity", "pose_interpolation"};
+// Each [stream.driver] type's own keys; a device type also takes the keys its protocols declare
+// (ProtocolKind below), which this file does not name.
 constexpr std::string_view kReplayKeys[] = {"type",   "path",   "timing",     "speed",        "schedule",     "loop",
                                             "rounds", "format", "joint",      "csv_prefix",   "skip_missing", "source_stream",
-                                            // a candump log (docs/can-devices.md)
-                                            "candump", "interface", "protocol", "time_source", "posefair_base_id",
-                                            "posefair_id_format", "xsens_quaternion_id", "xsens_sample_time_id",
-                                            "xsens_group_counter_id", "xsens_id_format", "xsens_sample_time_unit",
-                                            "dronecan_node_id"};
+                                            // a candump log (docs/can-devices.md), with a CAN protocol's keys
+                                            "candump", "interface", "protocol", "time_source"};
 constexpr std::string_view kSyntheticKeys[] = {"type", "rate_hz", "duration", "rotation_noise", "with_position", "seed", "phase"};
-constexpr std::string_view kSerialKeys[] = {"type",         "device",   "usb",           "serial_number",
-                                            "baud",         "data_bits", "parity",       "stop_bits",
-                                            "flow_control", "protocol", "witmotion_scalar", "time_source",
-                                            "reconnect_min", "reconnect_max", "vectornav_unchecked", "yost_header",
-                                            "yost_data_length"};
-constexpr std::string_view kHidKeys[] = {"type",          "device",        "usb",         "serial_number",   "protocol",
-                                         "report_id",     "component_order", "conjugate", "timestamp_count_s",
-                                         "report_length", "value_type",    "byte_order",  "offsets",         "offsets_bits",
-                                         "order",         "scale",         "time_source", "reconnect_min",   "reconnect_max"};
-// [stream.driver] type = "hid": the keys of one HID protocol only.
-constexpr std::string_view kHidSensorOnlyKeys[] = {"component_order", "conjugate", "timestamp_count_s"};
-constexpr std::string_view kHidVendorOnlyKeys[] = {"report_length", "value_type", "byte_order", "offsets", "offsets_bits", "order", "scale"};
-
-// Decoder options (drivers::DecoderOptions), each valid with one protocol only. The decoder
-// judges the value itself (make_decoder throws std::invalid_argument for a bad one).
-struct ProtocolOption {
-  std::string_view key;
-  std::string_view protocol;
-  std::string drivers::DecoderOptions::*field;
-};
-const ProtocolOption kProtocolOptions[] = {
-    {"witmotion_scalar", "witmotion", &drivers::DecoderOptions::witmotion_scalar},
-    {"vectornav_unchecked", "vectornav", &drivers::DecoderOptions::vectornav_unchecked},
-    {"yost_header", "yost", &drivers::DecoderOptions::yost_header},
-    {"yost_data_length", "yost", &drivers::DecoderOptions::yost_data_length},
-};
-
+constexpr std::string_view kSerialKeys[] = {"type",          "device",       "usb",          "serial_number", "baud",
+                                            "data_bits",     "parity",       "stop_bits",    "flow_control",  "protocol",
+                                            "time_source",   "reconnect_min", "reconnect_max"};
+constexpr std::string_view kHidKeys[] = {"type",        "device",        "usb",          "serial_number", "protocol",
+                                         "time_source", "reconnect_min", "reconnect_max"};
 constexpr std::string_view kSocketCanKeys[] = {"type", "interface", "protocol", "fd", "time_source", "reconnect_min",
-                                               "reconnect_max", "posefair_base_id", "posefair_id_format",
-                                               "xsens_quaternion_id", "xsens_sample_time_id", "xsens_group_counter_id",
-                                               "xsens_id_format", "xsens_sample_time_unit", "dronecan_node_id"};
+                                               "reconnect_max"};
 
-// CAN decoder options (drivers::CanDecoderOptions), each valid with one CAN protocol only; the
-// decoder judges the value (make_can_decoder throws std::invalid_argument for a bad one).
-struct CanProtocolOption {
-  std::string_view key;
-  std::string_view protocol;
-  std::string drivers::CanDecoderOptions::*field;
+// One registry of device protocols (serial, CAN or HID) as the configuration sees it: names and
+// the options each declares (drivers/device_options.hpp). The wording of its errors is the
+// kind's own, as it always was.
+struct ProtocolInfo {
+  std::string_view name;
+  std::span<const drivers::OptionSpec> options;
 };
-const CanProtocolOption kCanProtocolOptions[] = {
-    {"posefair_base_id", "posefair-can", &drivers::CanDecoderOptions::posefair_base_id},
-    {"posefair_id_format", "posefair-can", &drivers::CanDecoderOptions::posefair_id_format},
-    {"xsens_quaternion_id", "xsens-can", &drivers::CanDecoderOptions::xsens_quaternion_id},
-    {"xsens_sample_time_id", "xsens-can", &drivers::CanDecoderOptions::xsens_sample_time_id},
-    {"xsens_group_counter_id", "xsens-can", &drivers::CanDecoderOptions::xsens_group_counter_id},
-    {"xsens_id_format", "xsens-can", &drivers::CanDecoderOptions::xsens_id_format},
-    {"xsens_sample_time_unit", "xsens-can", &drivers::CanDecoderOptions::xsens_sample_time_unit},
-    {"dronecan_node_id", "dronecan-ahrs", &drivers::CanDecoderOptions::dronecan_node_id},
+struct ProtocolKind {
+  std::string_view what;  // "unknown <what> 'x' (known: ...)"
+  bool closed_set;        // an unknown name is refused as a choice: "expected one of ..., got 'x'"
+  char owner_quote;       // how "only for protocol X" quotes X
+  std::vector<ProtocolInfo> protocols;  // sorted by name
+
+  const ProtocolInfo* find(std::string_view name) const {
+    for (const ProtocolInfo& p : protocols)
+      if (p.name == name) return &p;
+    return nullptr;
+  }
+  // The first protocol other than `except` that declares `key`, or nullptr.
+  const ProtocolInfo* owner_of(std::string_view key, std::string_view except) const {
+    for (const ProtocolInfo& p : protocols)
+      if (p.name != except && drivers::find_option(p.options, key) != nullptr) return &p;
+    return nullptr;
+  }
+  std::vector<std::string_view> names() const {
+    std::vector<std::string_view> n;
+    for (const ProtocolInfo& p : protocols) n.push_back(p.name);
+    return n;
+  }
+  // Every key some protocol declares, once each.
+  std::vector<std::string_view> all_keys() const {
+    std::vector<std::string_view> keys;
+    for (const ProtocolInfo& p : protocols)
+      for (const drivers::OptionSpec& o : p.options)
+        if (std::find(keys.begin(), keys.end(), o.name) == keys.end()) keys.push_back(o.name);
+    return keys;
+  }
 };
 
-// Each [stream.driver] type and its keys.
+template <class Entry>
+std::vector<ProtocolInfo> protocol_infos(std::span<const Entry* const> entries) {
+  std::vector<ProtocolInfo> infos;
+  for (const Entry* e : entries) infos.push_back({e->name, e->options});
+  std::sort(infos.begin(), infos.end(), [](const ProtocolInfo& a, const ProtocolInfo& b) { return a.name < b.name; });
+  return infos;
+}
+const ProtocolKind& serial_protocols() {
+  static const ProtocolKind kind{"protocol", false, '\'', protocol_infos(drivers::decoder_entries())};
+  return kind;
+}
+const ProtocolKind& can_protocols() {
+  static const ProtocolKind kind{"CAN protocol", false, '\'', protocol_infos(drivers::can_decoder_entries())};
+  return kind;
+}
+const ProtocolKind& hid_protocols() {
+  static const ProtocolKind kind{"HID protocol", true, '"', protocol_infos(drivers::hid_decoder_entries())};
+  return kind;
+}
+
+// Each [stream.driver] type: its own keys, and the protocols whose keys it also takes.
 struct DriverKind {
   DriverType type;
   std::string_view name;
-  std::span<const std::string_view> keys;
+  std::span<const std::string_view> own_keys;
+  const ProtocolKind* protocols;  // nullptr: none
+  std::vector<std::string_view> keys;  // own_keys and every key of `protocols`
 };
-const DriverKind kDriverKinds[] = {
-    {DriverType::Replay, "replay", kReplayKeys},
-    {DriverType::Synthetic, "synthetic", kSyntheticKeys},
-    {DriverType::Serial, "serial", kSerialKeys},
-    {DriverType::SocketCan, "socketcan", kSocketCanKeys},
-    {DriverType::Hid, "hid", kHidKeys},
+const std::vector<DriverKind>& driver_kinds() {
+  static const std::vector<DriverKind> kinds = [] {
+    std::vector<DriverKind> k{
+        {DriverType::Replay, "replay", kReplayKeys, &can_protocols(), {}},
+        {DriverType::Synthetic, "synthetic", kSyntheticKeys, nullptr, {}},
+        {DriverType::Serial, "serial", kSerialKeys, &serial_protocols(), {}},
+        {DriverType::SocketCan, "socketcan", kSocketCanKeys, &can_protocols(), {}},
+        {DriverType::Hid, "hid", kHidKeys, &hid_protocols(), {}},
+    };
+    for (DriverKind& d : k) {
+      d.keys.assign(d.own_keys.begin(), d.own_keys.end());
+      if (d.protocols == nullptr) continue;
+      for (std::string_view key : d.protocols->all_keys())
+        if (std::find(d.keys.begin(), d.keys.end(), key) == d.keys.end()) d.keys.push_back(key);
+    }
+    return k;
+  }();
+  return kinds;
+}
+
+// The protocol a device source named and the options it gave, for check_protocol.
+struct ProtocolGiven {
+  const toml::node* node = nullptr;  // the protocol key
+  std::string name;
+  const toml::node* first_option = nullptr;  // the first option given, for errors without a key
+  std::string first_option_key;
 };
+
 constexpr std::string_view kOutputKeys[] = {"encoding", "destinations", "ttl",          "interface",
                                             "loopback", "streams",      "angular_velocity"};
 constexpr std::string_view kRecorderKeys[] = {"path",  "enabled", "max_file_bytes", "flush_interval",
@@ -649,27 +691,126 @@ class Parser {
     }
   }
 
-  // A device source's protocol must be one of `known` ("unknown <what> ..." otherwise, with the
-  // list and a suggestion), and its decoder must accept the options: `make` builds it, and a
-  // refusal is blamed on the first decoder option given, else on the protocol.
+  // A string that must be one of `choices` ("expected one of ..." otherwise, with a suggestion).
+  std::string get_string_choice(const toml::node& n, const std::string& key, std::span<const std::string_view> choices) const {
+    const std::string s = get_string(n, key);
+    if (std::find(choices.begin(), choices.end(), s) != choices.end()) return s;
+    std::string list;
+    for (std::string_view c : choices) list += (list.empty() ? "" : ", ") + in_quotes(c);
+    fail(n, key, "expected one of " + list + ", got " + in_quotes(s) + suggestion(s, choices));
+  }
+
+  // One option value, checked against the TOML type its protocol declares.
+  drivers::OptionValue get_option(const toml::node& n, const std::string& key, const drivers::OptionSpec& spec) const {
+    using drivers::OptionType;
+    switch (spec.type) {
+      case OptionType::String:
+        if (!spec.choices.empty()) return get_string_choice(n, key, spec.choices);
+        return get_nonempty_string(n, key);
+      case OptionType::IntegerOrString:  // a number written either way: 0x4F or "0x4F"
+        if (n.is_integer()) return std::to_string(n.as_integer()->get());
+        return get_nonempty_string(n, key);
+      case OptionType::Integer:
+        if (!n.is_integer()) wrong_type(n, key, "an integer");
+        return n.as_integer()->get();
+      case OptionType::Float:
+        if (n.is_integer()) return static_cast<double>(n.as_integer()->get());
+        if (!n.is_floating_point()) wrong_type(n, key, "a number");
+        return n.as_floating_point()->get();
+      case OptionType::Boolean:
+        return get_bool(n, key);
+      case OptionType::IntegerArray: {
+        if (!n.is_array()) wrong_type(n, key, "an array of integers");
+        const toml::array& a = *n.as_array();
+        std::vector<std::int64_t> values;
+        for (std::size_t i = 0; i < a.size(); ++i) {
+          if (!a[i].is_integer()) wrong_type(a[i], element_key(key, i), "an integer");
+          values.push_back(a[i].as_integer()->get());
+        }
+        return values;
+      }
+    }
+    wrong_type(n, key, drivers::to_string(spec.type));
+  }
+
+  // The protocol key of a device source (required) and the options of its kind: a key another
+  // protocol of the kind declares is refused; each key the protocol declares is type-checked
+  // into `out`. The name itself is judged by check_protocol.
+  ProtocolGiven parse_protocol_options(const toml::table& t, const std::string& prefix, const ProtocolKind& kind,
+                                       drivers::OptionMap& out) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    ProtocolGiven g;
+    g.node = &require(t, "protocol", prefix);
+    g.name = get_nonempty_string(*g.node, key("protocol"));
+    const ProtocolInfo* own = kind.find(g.name);
+    // In file order, so that the first problem is the one reported.
+    std::vector<std::pair<const toml::key*, const toml::node*>> given;
+    for (auto&& [k, v] : t) given.emplace_back(&k, &v);
+    std::sort(given.begin(), given.end(), [](const auto& a, const auto& b) { return before(a.first->source().begin, b.first->source().begin); });
+    for (const auto& [k, n] : given) {
+      const std::string_view name = k->str();
+      const drivers::OptionSpec* spec = own ? drivers::find_option(own->options, name) : nullptr;
+      if (spec == nullptr) {
+        if (const ProtocolInfo* other = kind.owner_of(name, g.name)) {
+          const std::string q(1, kind.owner_quote);
+          fail(*n, key(name), "only for protocol " + q + std::string(other->name) + q + " (this source's protocol is " +
+                                  in_quotes(g.name) + ")");
+        }
+        continue;
+      }
+      out[std::string(name)] = get_option(*n, key(name), *spec);
+      if (g.first_option == nullptr) {
+        g.first_option = n;
+        g.first_option_key = key(name);
+      }
+    }
+    return g;
+  }
+
+  // A device source's protocol must be one of its kind's ("unknown <what> ..." otherwise, with
+  // the list and a suggestion), and its decoder must accept the options: `make` builds it. A
+  // refusal (drivers::OptionError) is blamed on the key it names, in the table when given;
+  // any other on the first option given, else on the protocol.
   template <class Make>
-  void check_protocol(const toml::node& protocol_node, const std::string& protocol_key, const std::string& protocol,
-                      const std::vector<std::string>& known, std::string_view what, const toml::node* option_node,
-                      const std::string& option_key, Make make) const {
-    if (std::find(known.begin(), known.end(), protocol) == known.end()) {
+  void check_protocol(const toml::table& t, const std::string& prefix, const ProtocolKind& kind, const ProtocolGiven& g,
+                      Make make) const {
+    const std::string protocol_key = join_key(prefix, "protocol");
+    if (kind.find(g.name) == nullptr) {
+      const std::vector<std::string_view> names = kind.names();
       std::string list;
-      for (const std::string& p : known) list += (list.empty() ? "" : ", ") + p;
-      const std::vector<std::string_view> names(known.begin(), known.end());
-      fail(protocol_node, protocol_key,
-           "unknown " + std::string(what) + " " + in_quotes(protocol) + " (known: " + (list.empty() ? "none" : list) +
-               ")" + suggestion(protocol, names));
+      for (std::string_view p : names) list += (list.empty() ? "" : ", ") + std::string(kind.closed_set ? in_quotes(p) : p);
+      if (kind.closed_set) fail(*g.node, protocol_key, "expected one of " + list + ", got " + in_quotes(g.name) + suggestion(g.name, names));
+      fail(*g.node, protocol_key,
+           "unknown " + std::string(kind.what) + " " + in_quotes(g.name) + " (known: " + (list.empty() ? "none" : list) + ")" +
+               suggestion(g.name, names));
     }
     try {
       make();  // the decoder judges its own options
+    } catch (const drivers::OptionError& e) {
+      blame_option(t, prefix, e);
     } catch (const std::invalid_argument& e) {
-      if (option_node != nullptr) fail(*option_node, option_key, e.what());
-      fail(protocol_node, protocol_key, e.what());
+      if (g.first_option != nullptr) fail(*g.first_option, g.first_option_key, e.what());
+      fail(*g.node, protocol_key, e.what());
     }
+  }
+
+  // Reports a decoder's refusal at the key it names: "name" or "name[n]" (an array element,
+  // 1-based); a key not in the table (a default judged against a given one) at the table.
+  [[noreturn]] void blame_option(const toml::table& t, const std::string& prefix, const drivers::OptionError& e) const {
+    std::string name = e.key();
+    std::size_t index = 0;
+    if (const std::size_t open = name.find('['); open != std::string::npos) {
+      index = static_cast<std::size_t>(std::strtoul(name.c_str() + open + 1, nullptr, 10));
+      name.resize(open);
+    }
+    std::string message = e.message();
+    if (!e.related_key().empty())
+      if (const toml::node* other = t.get(e.related_key()))
+        message += " (" + e.related_key() + " is set at line " + std::to_string(other->source().begin.line) + ")";
+    const toml::node* n = t.get(name);
+    if (n != nullptr && index > 0 && n->is_array() && index <= n->as_array()->size()) n = n->as_array()->get(index - 1);
+    if (n != nullptr) fail(*n, join_key(prefix, e.key()), message);
+    fail(t.source().begin, join_key(prefix, e.key()), message);
   }
 
   // time_source of a device source (time_base.hpp).
@@ -724,55 +865,22 @@ class Parser {
           {{"none", drivers::FlowControl::None}, {"xonxoff", drivers::FlowControl::XonXoff},
            {"rtscts", drivers::FlowControl::RtsCts}, {"dtrdsr", drivers::FlowControl::DtrDsr}});
 
-    const toml::node& protocol_node = require(t, "protocol", prefix);
-    c.protocol = get_nonempty_string(protocol_node, key("protocol"));
-    const toml::node* option_node = nullptr;  // the first decoder option given, for errors
-    std::string option_key;
-    for (const ProtocolOption& po : kProtocolOptions) {
-      const toml::node* n = t.get(po.key);
-      if (n == nullptr) continue;
-      if (c.protocol != po.protocol)
-        fail(*n, key(po.key), "only for protocol " + in_quotes(std::string(po.protocol)) +
-                                               " (this source's protocol is " + in_quotes(c.protocol) + ")");
-      // Numbers are welcome where the decoder reads a number (yost_header = 0x4F, yost_data_length = 16).
-      c.decoder.*po.field = n->is_integer() ? std::to_string(n->as_integer()->get()) : get_nonempty_string(*n, key(po.key));
-      if (option_node == nullptr) {
-        option_node = n;
-        option_key = key(po.key);
-      }
-    }
+    const ProtocolGiven g = parse_protocol_options(t, prefix, serial_protocols(), c.decoder);
+    c.protocol = g.name;
     parse_time_source(t, prefix, c.time_source);
     parse_reconnect(t, prefix, c.reconnect_min, c.reconnect_max);
 
     // Last, so that every other key is judged the same whichever decoders this build has.
-    check_protocol(protocol_node, key("protocol"), c.protocol, drivers::decoder_protocols(), "protocol", option_node,
-                   option_key, [&] { (void)drivers::make_decoder(c.protocol, c.decoder); });
+    check_protocol(t, prefix, serial_protocols(), g, [&] { (void)drivers::make_decoder(c.protocol, c.decoder); });
   }
 
   // The CAN keys a live SocketCAN source and a candump replay share: protocol (required), its
   // decoder options, time_source. The protocol is checked last, as for serial.
   void parse_can_decoder(const toml::table& t, const std::string& prefix, SocketCanSourceConfig& c) const {
-    auto key = [&](std::string_view name) { return join_key(prefix, name); };
-    const toml::node& protocol_node = require(t, "protocol", prefix);
-    c.protocol = get_nonempty_string(protocol_node, key("protocol"));
-    const toml::node* option_node = nullptr;  // the first decoder option given, for errors
-    std::string option_key;
-    for (const CanProtocolOption& po : kCanProtocolOptions) {
-      const toml::node* n = t.get(po.key);
-      if (n == nullptr) continue;
-      if (c.protocol != po.protocol)
-        fail(*n, key(po.key), "only for protocol " + in_quotes(po.protocol) + " (this source's protocol is " +
-                                  in_quotes(c.protocol) + ")");
-      // Numbers are welcome for identifiers (posefair_base_id = 0x204, dronecan_node_id = 42).
-      c.decoder.*po.field = n->is_integer() ? std::to_string(n->as_integer()->get()) : get_nonempty_string(*n, key(po.key));
-      if (option_node == nullptr) {
-        option_node = n;
-        option_key = key(po.key);
-      }
-    }
+    const ProtocolGiven g = parse_protocol_options(t, prefix, can_protocols(), c.decoder);
+    c.protocol = g.name;
     parse_time_source(t, prefix, c.time_source);
-    check_protocol(protocol_node, key("protocol"), c.protocol, drivers::can_decoder_protocols(), "CAN protocol",
-                   option_node, option_key, [&] { (void)drivers::make_can_decoder(c.protocol, c.decoder); });
+    check_protocol(t, prefix, can_protocols(), g, [&] { (void)drivers::make_can_decoder(c.protocol, c.decoder); });
   }
 
   // A network interface name as the kernel takes it: 1..15 characters, no '/', no blanks.
@@ -824,94 +932,15 @@ class Parser {
   }
 
   // [stream.driver] with type = "hid" (docs/hid-gpio.md). The device is not opened (nor
-  // required to exist): the driver waits for it, and hid-sensor reads its layout from it.
+  // required to exist): the driver waits for it (a protocol may read the report layout from it).
   void parse_hid(const toml::table& t, const std::string& prefix, HidSourceConfig& c) const {
-    auto key = [&](std::string_view name) { return join_key(prefix, name); };
     parse_device_selection(t, prefix, "'/dev/hidraw0'", "'0483:5750'", c.device.device, c.device.usb, c.device.serial);
 
-    const toml::node& protocol_node = require(t, "protocol", prefix);
-    c.protocol = get_choice<drivers::HidProtocol>(protocol_node, key("protocol"),
-                                                  {{"hid-sensor", drivers::HidProtocol::Sensor},
-                                                   {"hid-vendor", drivers::HidProtocol::Vendor}});
-    const bool sensor = c.protocol == drivers::HidProtocol::Sensor;
-    for (std::string_view k : sensor ? std::span<const std::string_view>(kHidVendorOnlyKeys) : std::span<const std::string_view>(kHidSensorOnlyKeys)) {
-      if (const toml::node* n = t.get(k))
-        fail(*n, key(k), std::string("only for protocol ") + (sensor ? "\"hid-vendor\"" : "\"hid-sensor\"") +
-                             " (this source's protocol is " + in_quotes(std::string(to_string(c.protocol))) + ")");
-    }
-    if (sensor)
-      parse_hid_sensor(t, prefix, c.sensor);
-    else
-      parse_hid_vendor(t, prefix, c.vendor);
-
+    const ProtocolGiven g = parse_protocol_options(t, prefix, hid_protocols(), c.decoder);
+    c.protocol = g.name;
     parse_time_source(t, prefix, c.time_source);
     parse_reconnect(t, prefix, c.reconnect_min, c.reconnect_max);
-  }
-
-  void parse_hid_sensor(const toml::table& t, const std::string& prefix, drivers::HidSensorOrientationOptions& o) const {
-    auto key = [&](std::string_view name) { return join_key(prefix, name); };
-    // Absent: the first input report with an orientation quaternion; 0: a device without report IDs.
-    if (const toml::node* n = t.get("report_id")) o.report_id = static_cast<int>(get_int(*n, key("report_id"), 0, 255));
-    if (const toml::node* n = t.get("component_order")) {
-      o.component_order = get_string(*n, key("component_order"));
-      std::string sorted = o.component_order;
-      std::sort(sorted.begin(), sorted.end());
-      if (sorted != "wxyz")
-        fail(*n, key("component_order"), "must be the letters w, x, y, z each once in report order, e.g. \"xyzw\" or \"wxyz\", got " +
-                                             in_quotes(o.component_order));
-    }
-    if (const toml::node* n = t.get("conjugate")) o.conjugate = get_bool(*n, key("conjugate"));
-    if (const toml::node* n = t.get("timestamp_count_s")) o.timestamp_count_s = get_float(*n, key("timestamp_count_s"), kPositive);
-  }
-
-  void parse_hid_vendor(const toml::table& t, const std::string& prefix, drivers::HidVendorLayout& l) const {
-    auto key = [&](std::string_view name) { return join_key(prefix, name); };
-    const toml::node* report_id = t.get("report_id");
-    if (report_id != nullptr) l.report_id = static_cast<int>(get_int(*report_id, key("report_id"), -1, 255));
-    if (report_id != nullptr && l.report_id == 0)
-      fail(*report_id, key("report_id"), "0 is reserved by HID: give the report's ID (1..255), or -1 for a device without report IDs");
-    const toml::node* length = t.get("report_length");
-    if (length != nullptr) l.report_length = static_cast<std::uint32_t>(get_int(*length, key("report_length"), 0, 16384));
-    if (const toml::node* n = t.get("value_type"))
-      l.type = get_choice<drivers::HidVendorType>(*n, key("value_type"),
-                                                  {{"int16", drivers::HidVendorType::Int16}, {"int32", drivers::HidVendorType::Int32},
-                                                   {"float32", drivers::HidVendorType::Float32}, {"float64", drivers::HidVendorType::Float64}});
-    if (const toml::node* n = t.get("byte_order"))
-      l.big_endian = get_choice<bool>(*n, key("byte_order"), {{"little", false}, {"big", true}});
-    if (const toml::node* n = t.get("order"))
-      l.w_first = get_choice<bool>(*n, key("order"), {{"w-first", true}, {"w-last", false}});
-    const toml::node* scale = t.get("scale");
-    if (scale != nullptr) {
-      l.scale = get_float(*scale, key("scale"), FloatRange{});
-      if (l.scale == 0.0) fail(*scale, key("scale"), "must not be 0 (value = raw * scale)");
-    }
-    const toml::node* bytes = t.get("offsets");
-    const toml::node* bits = t.get("offsets_bits");
-    if (bytes != nullptr && bits != nullptr)
-      fail(*bits, key("offsets_bits"), "give either offsets (bytes) or offsets_bits, not both (offsets is set at line " +
-                                           std::to_string(bytes->source().begin.line) + ")");
-    if (bytes == nullptr && bits == nullptr)
-      fail(t.source().begin, key("offsets"), "missing required key: offsets (four byte offsets) or offsets_bits");
-    const toml::node& offsets = bytes != nullptr ? *bytes : *bits;
-    const std::string offsets_key = key(bytes != nullptr ? "offsets" : "offsets_bits");
-    if (!offsets.is_array() || offsets.as_array()->size() != 4)
-      fail(offsets, offsets_key, "expected an array of four offsets (the values in report order), e.g. [0, 2, 4, 6]");
-    const toml::array& a = *offsets.as_array();
-    const std::uint32_t unit = bytes != nullptr ? 8 : 1;
-    for (std::size_t k = 0; k < 4; ++k)
-      l.offset_bits[k] = static_cast<std::uint32_t>(get_int(a[k], element_key(offsets_key, k), 0, 16384 * 8 / unit)) * unit;
-    try {
-      drivers::validate_hid_vendor_layout(l);
-    } catch (const drivers::HidVendorLayoutError& e) {
-      const std::string& f = e.field();
-      if (f.starts_with("offset_bits[")) {
-        const std::size_t k = static_cast<std::size_t>(f[12] - '0');
-        fail(a[k], element_key(offsets_key, k), e.what());
-      }
-      const toml::node* at = f == "report_length" ? length : f == "report_id" ? report_id : f == "scale" ? scale : nullptr;
-      if (at != nullptr) fail(*at, key(f), e.what());
-      fail(t.source().begin, key(f), e.what());
-    }
+    check_protocol(t, prefix, hid_protocols(), g, [&] { (void)drivers::configure_hid_decoder(c.protocol, c.decoder); });
   }
 
   // [stream.driver]; returns a synthetic driver's rate (the engine's default rate_hz).
@@ -922,8 +951,9 @@ class Parser {
         type_node, type_key,
         {{"replay", DriverType::Replay}, {"synthetic", DriverType::Synthetic}, {"serial", DriverType::Serial},
          {"socketcan", DriverType::SocketCan}, {"hid", DriverType::Hid}});
-    const DriverKind* own = &kDriverKinds[0];
-    for (const DriverKind& k : kDriverKinds)
+    const std::vector<DriverKind>& kinds = driver_kinds();
+    const DriverKind* own = &kinds[0];
+    for (const DriverKind& k : kinds)
       if (k.type == s.driver.type) own = &k;
     const toml::key* first = nullptr;
     for (auto&& [k, v] : t) {
@@ -933,11 +963,21 @@ class Parser {
     if (first != nullptr) {
       const std::string key = join_key(prefix, first->str());
       const std::string unknown = "unknown key for driver type " + std::string(own->name);
-      for (const DriverKind& other : kDriverKinds) {
+      for (const DriverKind& other : kinds) {
         if (std::find(other.keys.begin(), other.keys.end(), first->str()) != other.keys.end())
           fail(first->source().begin, key, unknown + " (it belongs to type " + std::string(other.name) + ")");
       }
-      fail(first->source().begin, key, unknown + suggestion(first->str(), own->keys));
+      // Suggestions among the type's own keys and those of the protocol named, when it is known.
+      std::vector<std::string_view> candidates = own->keys;
+      const toml::node* protocol = t.get("protocol");
+      const ProtocolInfo* info = own->protocols && protocol && protocol->is_string()
+                                     ? own->protocols->find(protocol->as_string()->get())
+                                     : nullptr;
+      if (info != nullptr) {
+        candidates.assign(own->own_keys.begin(), own->own_keys.end());
+        for (const drivers::OptionSpec& o : info->options) candidates.push_back(o.name);
+      }
+      fail(first->source().begin, key, unknown + suggestion(first->str(), candidates));
     }
     if (s.driver.type == DriverType::Serial) {
       parse_serial(t, prefix, s.driver.serial);
@@ -962,8 +1002,8 @@ class Parser {
       ReplaySourceConfig& r = s.driver.replay;
       for (std::string_view can_key : {"interface", "protocol", "time_source"})
         if (const toml::node* n = t.get(can_key)) fail(*n, key(can_key), "only for a candump log (key candump)");
-      for (const CanProtocolOption& po : kCanProtocolOptions)
-        if (const toml::node* n = t.get(po.key)) fail(*n, key(po.key), "only for a candump log (key candump)");
+      for (std::string_view can_key : can_protocols().all_keys())
+        if (const toml::node* n = t.get(can_key)) fail(*n, key(can_key), "only for a candump log (key candump)");
       const toml::node& path_node = require(t, "path", prefix);
       r.path = resolve(get_nonempty_string(path_node, key("path")));
       std::error_code ec;

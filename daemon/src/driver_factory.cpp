@@ -168,10 +168,9 @@ MadeDriver make_hid(const StreamConfig& stream) {
   drivers::HidrawDriverOptions o;
   o.device = hc.device;
   o.protocol = hc.protocol;
-  o.sensor = hc.sensor;
-  o.vendor = hc.vendor;
-  return make_device_driver<drivers::HidrawDriver>(
-      stream, hc, std::move(o), "hid:" + hc.device.describe() + " (" + std::string(drivers::to_string(hc.protocol)) + ")");
+  o.decoder_options = hc.decoder;
+  return make_device_driver<drivers::HidrawDriver>(stream, hc, std::move(o),
+                                                   "hid:" + hc.device.describe() + " (" + hc.protocol + ")");
 }
 
 MadeDriver make_socketcan(const StreamConfig& stream) {

@@ -155,7 +155,11 @@ class Bno08xRvcDecoder final : public Decoder {
 
 }  // namespace
 
-std::unique_ptr<Decoder> make_bno08x_rvc_decoder(const DecoderOptions& /*options*/) {
+const DecoderEntry kBno08xRvcDecoder{"bno08x-rvc", "CEVA / Hillcrest BNO080, BNO085, BNO086 in UART-RVC mode: yaw, pitch, roll",
+                                     {}, make_bno08x_rvc_decoder};
+
+std::unique_ptr<Decoder> make_bno08x_rvc_decoder(const OptionMap& options) {
+  (void)OptionReader({}, options);  // it reads none: refuses any
   return std::make_unique<Bno08xRvcDecoder>();
 }
 

@@ -1,7 +1,6 @@
 // The decoder registry: one line per protocol (decoder.hpp), in the manner of gpsd's driver
-// table. A new protocol is one <protocol>_decoder.cpp plus one line here.
+// table. A new protocol is one <protocol>_decoder.cpp (with its DecoderEntry) plus one line here.
 #include <algorithm>
-#include <stdexcept>
 
 #include "posefair/drivers/bno08x_rvc_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
@@ -14,32 +13,34 @@
 namespace posefair::drivers {
 namespace {
 
-struct Entry {
-  std::string_view name;
-  std::unique_ptr<Decoder> (*make)(const DecoderOptions&);
-};
-
-constexpr Entry kDecoders[] = {
-    {"bno08x-rvc", make_bno08x_rvc_decoder},
-    {"posefair", make_posefair_serial_decoder},
-    {"vectornav", make_vectornav_decoder},
-    {"xsens", make_xsens_decoder},
-    {"witmotion", make_witmotion_decoder},
-    {"yost", make_yost_decoder},
+// Sorted by name.
+const DecoderEntry* const kDecoders[] = {
+    &kBno08xRvcDecoder,
+    &kPosefairSerialDecoder,
+    &kVectorNavDecoder,
+    &kWitMotionDecoder,
+    &kXsensDecoder,
+    &kYostDecoder,
 };
 
 }  // namespace
 
-std::unique_ptr<Decoder> make_decoder(std::string_view protocol, const DecoderOptions& options) {
-  for (const Entry& e : kDecoders)
-    if (e.make && e.name == protocol) return e.make(options);
+std::span<const DecoderEntry* const> decoder_entries() { return kDecoders; }
+
+const DecoderEntry* find_decoder(std::string_view protocol) {
+  for (const DecoderEntry* e : kDecoders)
+    if (e->name == protocol) return e;
   return nullptr;
+}
+
+std::unique_ptr<Decoder> make_decoder(std::string_view protocol, const OptionMap& options) {
+  const DecoderEntry* e = find_decoder(protocol);
+  return e ? e->make(options) : nullptr;
 }
 
 std::vector<std::string> decoder_protocols() {
   std::vector<std::string> names;
-  for (const Entry& e : kDecoders)
-    if (e.make) names.emplace_back(e.name);
+  for (const DecoderEntry* e : kDecoders) names.emplace_back(e->name);
   std::sort(names.begin(), names.end());
   return names;
 }

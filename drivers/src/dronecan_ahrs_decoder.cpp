@@ -240,10 +240,22 @@ void put_half(std::vector<std::uint8_t>& out, double v) {
 
 }  // namespace
 
-std::unique_ptr<CanDecoder> make_dronecan_ahrs_decoder(const CanDecoderOptions& options) {
-  if (options.dronecan_node_id == "any") return std::make_unique<DroneCanAhrsDecoder>(-1);
-  const std::uint32_t node = parse_can_id_option("dronecan_node_id", options.dronecan_node_id, 127);
-  if (node == 0) throw std::invalid_argument("dronecan_node_id: 0 is the anonymous node; give 1 .. 127 or \"any\"");
+namespace {
+constexpr OptionSpec kOptions[] = {
+    {"dronecan_node_id", OptionType::IntegerOrString, "any",
+     "the source node to read (1..127), or any: every node's transfers, reassembled per node"},
+};
+}  // namespace
+
+const CanDecoderEntry kDroneCanAhrsDecoder{"dronecan-ahrs", "DroneCAN (UAVCAN v0) uavcan.equipment.ahrs.Solution broadcasts",
+                                           kOptions, make_dronecan_ahrs_decoder};
+
+std::unique_ptr<CanDecoder> make_dronecan_ahrs_decoder(const OptionMap& options) {
+  const OptionReader read(kOptions, options);
+  const std::string node_id = read.text("dronecan_node_id");
+  if (node_id == "any") return std::make_unique<DroneCanAhrsDecoder>(-1);
+  const std::uint32_t node = parse_can_id_option("dronecan_node_id", node_id, 127);
+  if (node == 0) throw OptionError("dronecan_node_id", "0 is the anonymous node; give 1 .. 127 or \"any\"");
   return std::make_unique<DroneCanAhrsDecoder>(static_cast<int>(node));
 }
 

@@ -43,6 +43,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <utility>
+#include <variant>
 #include <stdexcept>
 #include <string>
 
@@ -248,6 +251,66 @@ HidOrientationLayout resolve_hid_orientation_layout(const HidReportDescriptor& d
 std::unique_ptr<HidReportDecoder> make_hid_sensor_orientation_decoder(const HidOrientationLayout& layout,
                                                                       const HidSensorOrientationOptions& options) {
   return std::make_unique<HidSensorOrientationDecoder>(layout, options);
+}
+
+namespace {
+
+constexpr OptionSpec kOptions[] = {
+    {"report_id", OptionType::Integer, "", "the input report to read (0: a device without report IDs); absent: the first with a quaternion"},
+    {"component_order", OptionType::String, "xyzw", "the order of the quaternion's four values in the report"},
+    {"conjugate", OptionType::Boolean, "false", "hand out q* (for a device whose quaternion rotates world into sensor)"},
+    {"timestamp_count_s", OptionType::Float, "1e-6", "seconds per timestamp count when the Timestamp field declares no unit"},
+};
+
+std::string number_text(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+// Resolves each opened device's descriptor with the configured options.
+class HidSensorFactory final : public HidDecoderFactory {
+ public:
+  explicit HidSensorFactory(HidSensorOrientationOptions options) : options_(std::move(options)) {}
+  std::unique_ptr<HidReportDecoder> make(std::span<const std::uint8_t> descriptor, std::string& what) const override {
+    auto parsed = parse_hid_report_descriptor(descriptor);
+    if (const auto* error = std::get_if<HidDescriptorError>(&parsed)) throw std::invalid_argument(error->message);
+    const HidOrientationLayout layout = resolve_hid_orientation_layout(std::get<HidReportDescriptor>(parsed), options_);
+    what = "input report " + std::to_string(layout.report_id) + " of " + std::to_string(layout.report_bytes) + " bytes" +
+           (layout.timestamp ? " with a timestamp" : "");
+    return make_hid_sensor_orientation_decoder(layout, options_);
+  }
+
+ private:
+  HidSensorOrientationOptions options_;
+};
+
+std::unique_ptr<HidDecoderFactory> configure_hid_sensor(const OptionMap& options) {
+  return std::make_unique<HidSensorFactory>(hid_sensor_options(options));
+}
+
+}  // namespace
+
+const HidDecoderEntry kHidSensorDecoder{"hid-sensor",
+                                        "HID Sensor usage page orientation sensors: the quaternion field, from the report descriptor",
+                                        kOptions, configure_hid_sensor};
+
+HidSensorOrientationOptions hid_sensor_options(const OptionMap& options) {
+  const OptionReader read(kOptions, options);
+  HidSensorOrientationOptions o;
+  // Absent: the first input report with an orientation quaternion; 0: a device without report IDs.
+  if (read.has("report_id")) o.report_id = static_cast<int>(read.integer("report_id", 0, 255));
+  o.component_order = read.text("component_order");
+  std::string sorted = o.component_order;
+  std::sort(sorted.begin(), sorted.end());
+  if (sorted != "wxyz")
+    throw OptionError("component_order", "must be the letters w, x, y, z each once in report order, e.g. \"xyzw\" or \"wxyz\", got '" +
+                                             o.component_order + "'");
+  o.conjugate = read.boolean("conjugate");
+  o.timestamp_count_s = read.real("timestamp_count_s");
+  if (!(o.timestamp_count_s > 0.0) || !std::isfinite(o.timestamp_count_s))
+    throw OptionError("timestamp_count_s", "out of range: must be > 0, got " + number_text(o.timestamp_count_s));
+  return o;
 }
 
 std::vector<std::uint8_t> encode_hid_orientation_report(const HidOrientationLayout& layout, const Quat& q_in,

@@ -20,6 +20,8 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "posefair/drivers/hid_report_descriptor.hpp"
 
@@ -159,6 +161,85 @@ void validate_hid_vendor_layout(const HidVendorLayout& l) {
 std::unique_ptr<HidReportDecoder> make_hid_vendor_layout_decoder(const HidVendorLayout& layout) {
   validate_hid_vendor_layout(layout);
   return std::make_unique<HidVendorLayoutDecoder>(layout);
+}
+
+namespace {
+
+constexpr std::string_view kValueTypes[] = {"int16", "int32", "float32", "float64"};
+constexpr std::string_view kByteOrders[] = {"little", "big"};
+constexpr std::string_view kOrders[] = {"w-first", "w-last"};
+constexpr OptionSpec kOptions[] = {
+    {"report_id", OptionType::Integer, "-1", "the report ID (1..255, the first byte of each report), or -1: no report IDs"},
+    {"report_length", OptionType::Integer, "0", "data bytes after the ID byte; 0: just what the values need"},
+    {"value_type", OptionType::String, "int16", "the type of the four values", kValueTypes},
+    {"byte_order", OptionType::String, "little", "the values' byte order", kByteOrders},
+    {"offsets", OptionType::IntegerArray, "", "the four values' byte offsets after the ID byte, in report order (or offsets_bits)"},
+    {"offsets_bits", OptionType::IntegerArray, "", "the same in bits (little-endian values may start at any bit)"},
+    {"order", OptionType::String, "w-first", "w-first (w x y z) or w-last (x y z w)", kOrders},
+    {"scale", OptionType::Float, "0.00006103515625", "value = raw * scale (the default 1/16384 is Q14)"},
+};
+
+// The configured layout; the same decoder for every device opened.
+class HidVendorFactory final : public HidDecoderFactory {
+ public:
+  explicit HidVendorFactory(const HidVendorLayout& layout) : layout_(layout) {}
+  std::unique_ptr<HidReportDecoder> make(std::span<const std::uint8_t> descriptor, std::string& what) const override {
+    what = "descriptor of " + std::to_string(descriptor.size()) + " bytes";
+    return make_hid_vendor_layout_decoder(layout_);
+  }
+
+ private:
+  HidVendorLayout layout_;
+};
+
+std::unique_ptr<HidDecoderFactory> configure_hid_vendor(const OptionMap& options) {
+  return std::make_unique<HidVendorFactory>(hid_vendor_layout(options));
+}
+
+}  // namespace
+
+const HidDecoderEntry kHidVendorDecoder{"hid-vendor", "a quaternion at configured offsets of a vendor-defined input report",
+                                        kOptions, configure_hid_vendor};
+
+HidVendorLayout hid_vendor_layout(const OptionMap& options) {
+  const OptionReader read(kOptions, options);
+  HidVendorLayout l;
+  l.report_id = static_cast<int>(read.integer("report_id", -1, 255));
+  if (l.report_id == 0)
+    throw HidVendorLayoutError("report_id", "report_id",
+                               "0 is reserved by HID: give the report's ID (1..255), or -1 for a device without report IDs");
+  l.report_length = static_cast<std::uint32_t>(read.integer("report_length", 0, kMaxReportLength));
+  constexpr HidVendorType kTypes[] = {HidVendorType::Int16, HidVendorType::Int32, HidVendorType::Float32, HidVendorType::Float64};
+  l.type = kTypes[read.choice("value_type")];
+  l.big_endian = read.choice("byte_order") == 1;
+  l.w_first = read.choice("order") == 0;
+  l.scale = read.real("scale");
+  if (!std::isfinite(l.scale)) throw OptionError("scale", "must be a finite number");
+  if (l.scale == 0.0) throw OptionError("scale", "must not be 0 (value = raw * scale)");
+  const bool bytes = read.has("offsets");
+  if (bytes && read.has("offsets_bits"))
+    throw OptionError("offsets_bits", "give either offsets (bytes) or offsets_bits, not both", "offsets");
+  if (!bytes && !read.has("offsets_bits"))
+    throw OptionError("offsets", "missing required key: offsets (four byte offsets) or offsets_bits");
+  const std::string key = bytes ? "offsets" : "offsets_bits";
+  const std::vector<std::int64_t> offsets = read.integers(key);
+  if (offsets.size() != 4) throw OptionError(key, "expected an array of four offsets (the values in report order), e.g. [0, 2, 4, 6]");
+  const std::uint32_t unit = bytes ? 8 : 1;
+  const std::int64_t max = std::int64_t{kMaxReportLength} * 8 / unit;
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (offsets[k] < 0 || offsets[k] > max)
+      throw OptionError(key + "[" + std::to_string(k + 1) + "]", "out of range: must be in [0, " + std::to_string(max) +
+                                                                   "], got " + std::to_string(offsets[k]));
+    l.offset_bits[k] = static_cast<std::uint32_t>(offsets[k]) * unit;
+  }
+  try {
+    validate_hid_vendor_layout(l);
+  } catch (const HidVendorLayoutError& e) {
+    const std::string& f = e.field();
+    if (f.starts_with("offset_bits[")) throw HidVendorLayoutError(e, key + "[" + std::to_string(f[12] - '0' + 1) + "]");
+    throw;  // its field is the key (report_id, report_length, scale)
+  }
+  return l;
 }
 
 std::vector<std::uint8_t> encode_hid_vendor_report(const HidVendorLayout& l, const Quat& q) {

@@ -22,11 +22,9 @@
 #include <stdexcept>
 #include <system_error>
 #include <utility>
-#include <variant>
 
 #include "link_log_text.hpp"
 #include "monotonic_clock.hpp"
-#include "posefair/drivers/hid_report_descriptor.hpp"
 #include "sample_stamper.hpp"
 
 namespace posefair::drivers {
@@ -141,10 +139,6 @@ std::vector<std::string> find_hidraw_nodes(const HidDeviceSpec& spec, const std:
   return nodes;
 }
 
-std::string_view to_string(HidProtocol protocol) {
-  return protocol == HidProtocol::Sensor ? "hid-sensor" : "hid-vendor";
-}
-
 HidrawDriver::HidrawDriver(HidrawDriverOptions options) : options_(std::move(options)) {
   if (!options_.device.usb && options_.device.device.empty())
     throw std::invalid_argument("hid: give a device path or a USB id");
@@ -155,17 +149,11 @@ HidrawDriver::HidrawDriver(HidrawDriverOptions options) : options_(std::move(opt
   if (!(options_.read_timeout > 0.0 && options_.read_timeout <= 0.05))
     throw std::invalid_argument("hid: read_timeout must be in (0, 0.05] s");
   const TimeBase check(options_.time_source, options_.time_base);  // throws for bad time base options
-  if (options_.protocol == HidProtocol::Vendor) {
-    vendor_decoder_ = make_hid_vendor_layout_decoder(options_.vendor);  // throws HidVendorLayoutError
-  } else {
-    // The descriptor comes with the device; the options can be judged now (an empty
-    // descriptor then fails for want of a quaternion, which is expected here).
-    try {
-      (void)resolve_hid_orientation_layout(HidReportDescriptor{}, options_.sensor);
-    } catch (const std::invalid_argument& e) {
-      const std::string what = e.what();
-      if (what.find("component_order") != std::string::npos || what.find("report_id") != std::string::npos) throw;
-    }
+  decoder_factory_ = configure_hid_decoder(options_.protocol, options_.decoder_options);  // throws OptionError
+  if (!decoder_factory_) {
+    std::string known;
+    for (const std::string& p : hid_decoder_protocols()) known += (known.empty() ? "" : ", ") + p;
+    throw std::invalid_argument("hid: unknown protocol '" + options_.protocol + "' (known: " + known + ")");
   }
   name_ = options_.name.empty() ? "hid:" + options_.device.describe() : options_.name;
 }
@@ -205,7 +193,7 @@ struct HidrawDriver::Opened {
   std::string path;
   std::string note;                             // worth one log line (several nodes matched)
   std::string what;                             // the report read, for the "opened" line
-  std::unique_ptr<HidReportDecoder> decoder;    // protocol Sensor: built from this node's descriptor
+  std::unique_ptr<HidReportDecoder> decoder;    // built for this node's descriptor
 };
 
 void HidrawDriver::run(std::stop_token stop, SampleSink& sink) {
@@ -218,7 +206,7 @@ void HidrawDriver::run(std::stop_token stop, SampleSink& sink) {
                   [] { return false; });
   };
 
-  // Opens the node and builds (Sensor) or resets (Vendor) the decoder.
+  // Opens the node and builds its decoder.
   auto open = [&](Opened& o) -> std::optional<OpenError> {
     std::string path = options_.device.device;
     o.note.clear();
@@ -247,20 +235,10 @@ void HidrawDriver::run(std::stop_token stop, SampleSink& sink) {
     hidraw_report_descriptor rd{};
     rd.size = static_cast<std::uint32_t>(std::clamp(size, 0, HID_MAX_DESCRIPTOR_SIZE));
     if (::ioctl(fd, HIDIOCGRDESC, &rd) < 0) return refuse(OpenFailure::Other, std::string("HIDIOCGRDESC: ") + std::strerror(errno));
-    if (options_.protocol == HidProtocol::Sensor) {
-      auto parsed = parse_hid_report_descriptor(std::span<const std::uint8_t>(rd.value, rd.size));
-      if (const auto* error = std::get_if<HidDescriptorError>(&parsed)) return refuse(OpenFailure::Descriptor, error->message);
-      try {
-        const HidOrientationLayout layout = resolve_hid_orientation_layout(std::get<HidReportDescriptor>(parsed), options_.sensor);
-        o.decoder = make_hid_sensor_orientation_decoder(layout, options_.sensor);
-        o.what = "input report " + std::to_string(layout.report_id) + " of " + std::to_string(layout.report_bytes) + " bytes" +
-                 (layout.timestamp ? " with a timestamp" : "");
-      } catch (const std::invalid_argument& e) {
-        return refuse(OpenFailure::Descriptor, e.what());
-      }
-    } else {
-      vendor_decoder_->reset();
-      o.what = "descriptor of " + std::to_string(rd.size) + " bytes";
+    try {
+      o.decoder = decoder_factory_->make(std::span<const std::uint8_t>(rd.value, rd.size), o.what);
+    } catch (const std::invalid_argument& e) {
+      return refuse(OpenFailure::Descriptor, e.what());
     }
     o.fd = fd;
     o.path = path;
@@ -273,11 +251,10 @@ void HidrawDriver::run(std::stop_token stop, SampleSink& sink) {
   std::uint64_t sequence = 0;
   SampleStamper stamper(options_.stream_id, time_base, sink, sequence, samples_, dropped_);
   Opened node;
-  DecoderCounters past;  // of the decoders of earlier connections (hid-sensor builds one per open)
-  auto decoder = [&]() -> HidReportDecoder& { return node.decoder ? *node.decoder : *vendor_decoder_; };
+  DecoderCounters past;  // of the decoders of earlier connections (one is built per open)
   auto publish = [&] {
     DecoderCounters sum = past;
-    if (node.decoder || vendor_decoder_) sum += decoder().counters();
+    if (node.decoder) sum += node.decoder->counters();
     {
       std::lock_guard lock(snapshot_mutex_);
       decoder_snapshot_ = sum;
@@ -329,7 +306,7 @@ void HidrawDriver::run(std::stop_token stop, SampleSink& sink) {
         reconnects_.fetch_add(1, std::memory_order_relaxed);
         log(LogLevel::Info, "reopened " + where + " after " + seconds_text(waited) + " and " + attempts_text(attempts + 1));
       } else {
-        std::string line = "opened " + where + ", protocol " + std::string(to_string(options_.protocol)) + " (" + node.what +
+        std::string line = "opened " + where + ", protocol " + options_.protocol + " (" + node.what +
                            "), time source " + std::string(to_string(options_.time_source));
         if (attempts > 0) line += " after " + seconds_text(waited) + " and " + attempts_text(attempts + 1);
         log(LogLevel::Info, line);
@@ -360,7 +337,7 @@ void HidrawDriver::run(std::stop_token stop, SampleSink& sink) {
         transient_streak = 0;
         reports_.fetch_add(1, std::memory_order_relaxed);
         stamper.set_receive_time(received);
-        decoder().decode(std::span<const std::uint8_t>(buffer.data(), static_cast<std::size_t>(n)), stamper);
+        node.decoder->decode(std::span<const std::uint8_t>(buffer.data(), static_cast<std::size_t>(n)), stamper);
         publish();
         continue;
       }

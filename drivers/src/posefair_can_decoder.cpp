@@ -173,10 +173,22 @@ std::int16_t to_i16(double v, double scale) {
 
 }  // namespace
 
-std::unique_ptr<CanDecoder> make_posefair_can_decoder(const CanDecoderOptions& options) {
-  const bool extended = parse_can_id_format_option("posefair_id_format", options.posefair_id_format);
+namespace {
+constexpr std::string_view kIdFormats[] = {"standard", "extended"};
+constexpr OptionSpec kOptions[] = {
+    {"posefair_base_id", OptionType::IntegerOrString, "0x200", "the base identifier B: frames B, B+1, B+2"},
+    {"posefair_id_format", OptionType::String, "standard", "standard (11-bit) or extended (29-bit) identifiers", kIdFormats},
+};
+}  // namespace
+
+const CanDecoderEntry kPosefairCanDecoder{"posefair-can", "posefair's own CAN layout: quaternion, time and position frames",
+                                          kOptions, make_posefair_can_decoder};
+
+std::unique_ptr<CanDecoder> make_posefair_can_decoder(const OptionMap& options) {
+  const OptionReader read(kOptions, options);
+  const bool extended = parse_can_id_format_option("posefair_id_format", read.text("posefair_id_format"));
   const std::uint32_t max = (extended ? CanFrame::kEffMask : CanFrame::kSffMask) - kQuaternion;
-  return std::make_unique<PosefairCanDecoder>(parse_can_id_option("posefair_base_id", options.posefair_base_id, max), extended);
+  return std::make_unique<PosefairCanDecoder>(parse_can_id_option("posefair_base_id", read.text("posefair_base_id"), max), extended);
 }
 
 std::vector<CanFrame> encode_posefair_can(std::uint32_t base_id, bool extended, const Quat& q,

@@ -304,7 +304,11 @@ void append_number(std::string& out, double v) {
 
 }  // namespace
 
-std::unique_ptr<Decoder> make_posefair_serial_decoder(const DecoderOptions& /*options*/) {
+const DecoderEntry kPosefairSerialDecoder{"posefair", "posefair's own protocol for microcontrollers: $PFQ text and F5 50 frames",
+                                          {}, make_posefair_serial_decoder};
+
+std::unique_ptr<Decoder> make_posefair_serial_decoder(const OptionMap& options) {
+  (void)OptionReader({}, options);  // it reads none: refuses any
   return std::make_unique<PosefairSerialDecoder>();
 }
 

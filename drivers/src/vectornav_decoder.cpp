@@ -316,11 +316,24 @@ void append_mag_accel_gyro(std::string& s) {
 
 }  // namespace
 
-std::unique_ptr<Decoder> make_vectornav_decoder(const DecoderOptions& options) {
-  if (options.vectornav_unchecked == "reject") return std::make_unique<VectorNavDecoder>(false);
-  if (options.vectornav_unchecked == "accept") return std::make_unique<VectorNavDecoder>(true);
-  throw std::invalid_argument("vectornav_unchecked: expected \"reject\" or \"accept\", got \"" +
-                              options.vectornav_unchecked + "\"");
+namespace {
+constexpr std::string_view kUncheckedChoices[] = {"reject", "accept"};
+constexpr OptionSpec kOptions[] = {
+    {"vectornav_unchecked", OptionType::String, "reject",
+     "sentences with checksum XX (checksums off on the device): reject (count as bad_checksum) or accept",
+     kUncheckedChoices},
+};
+}  // namespace
+
+const DecoderEntry kVectorNavDecoder{"vectornav", "VectorNav VN-100/200/300 ASCII: $VNQMR, $VNYMR and kin", kOptions,
+                                     make_vectornav_decoder};
+
+std::unique_ptr<Decoder> make_vectornav_decoder(const OptionMap& options) {
+  const OptionReader read(kOptions, options);
+  const std::string unchecked = read.text("vectornav_unchecked");
+  if (unchecked == "reject") return std::make_unique<VectorNavDecoder>(false);
+  if (unchecked == "accept") return std::make_unique<VectorNavDecoder>(true);
+  throw OptionError("vectornav_unchecked", "expected \"reject\" or \"accept\", got \"" + unchecked + "\"");
 }
 
 std::string vectornav_checksum(const std::string& body, bool crc16) {

@@ -248,11 +248,23 @@ class WitMotionDecoder final : public Decoder {
 
 }  // namespace
 
-std::unique_ptr<Decoder> make_witmotion_decoder(const DecoderOptions& options) {
-  if (options.witmotion_scalar == "first") return std::make_unique<WitMotionDecoder>(true);
-  if (options.witmotion_scalar == "last") return std::make_unique<WitMotionDecoder>(false);
-  throw std::invalid_argument("witmotion_scalar must be \"first\" or \"last\", not \"" + options.witmotion_scalar +
-                              "\"");
+namespace {
+constexpr std::string_view kScalarChoices[] = {"first", "last"};
+constexpr OptionSpec kOptions[] = {
+    {"witmotion_scalar", OptionType::String, "first",
+     "which int16 of the 0x59 quaternion frame is the scalar: first (w x y z) or last (x y z w)", kScalarChoices},
+};
+}  // namespace
+
+const DecoderEntry kWitMotionDecoder{"witmotion", "WitMotion WT901 family: 0x55 frames, quaternion (0x59) or angles (0x53)",
+                                     kOptions, make_witmotion_decoder};
+
+std::unique_ptr<Decoder> make_witmotion_decoder(const OptionMap& options) {
+  const OptionReader read(kOptions, options);
+  const std::string scalar = read.text("witmotion_scalar");
+  if (scalar == "first") return std::make_unique<WitMotionDecoder>(true);
+  if (scalar == "last") return std::make_unique<WitMotionDecoder>(false);
+  throw OptionError("witmotion_scalar", "must be \"first\" or \"last\", not \"" + scalar + "\"");
 }
 
 std::array<std::uint8_t, kWitMotionFrameSize> encode_witmotion_frame(std::uint8_t type,

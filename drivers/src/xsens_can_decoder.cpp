@@ -145,22 +145,45 @@ class XsensCanDecoder final : public CanDecoder {
 
 }  // namespace
 
-std::unique_ptr<CanDecoder> make_xsens_can_decoder(const CanDecoderOptions& o) {
+namespace {
+constexpr std::string_view kIdFormats[] = {"standard", "extended"};
+constexpr std::string_view kTimeUnits[] = {"100us", "1us"};
+constexpr OptionSpec kOptions[] = {
+    {"xsens_quaternion_id", OptionType::IntegerOrString, "0x021", "the identifier of the Quaternion message"},
+    {"xsens_sample_time_id", OptionType::IntegerOrString, "0x005", "the identifier of the SampleTime message"},
+    {"xsens_group_counter_id", OptionType::IntegerOrString, "0x006", "the identifier of the GroupCounter message"},
+    {"xsens_id_format", OptionType::String, "standard", "standard (11-bit) or extended (29-bit) identifiers", kIdFormats},
+    {"xsens_sample_time_unit", OptionType::String, "100us",
+     "the unit of SampleTime: 100us (Xsens' current CAN documentation) or 1us", kTimeUnits},
+};
+}  // namespace
+
+const CanDecoderEntry kXsensCanDecoder{"xsens-can", "Xsens MTi CAN output: Quaternion, SampleTime and GroupCounter messages",
+                                       kOptions, make_xsens_can_decoder};
+
+std::unique_ptr<CanDecoder> make_xsens_can_decoder(const OptionMap& options) {
+  const OptionReader read(kOptions, options);
   XsensIds ids{};
-  ids.extended = parse_can_id_format_option("xsens_id_format", o.xsens_id_format);
+  ids.extended = parse_can_id_format_option("xsens_id_format", read.text("xsens_id_format"));
   const std::uint32_t max = ids.extended ? CanFrame::kEffMask : CanFrame::kSffMask;
-  ids.quaternion = parse_can_id_option("xsens_quaternion_id", o.xsens_quaternion_id, max);
-  ids.sample_time = parse_can_id_option("xsens_sample_time_id", o.xsens_sample_time_id, max);
-  ids.group_counter = parse_can_id_option("xsens_group_counter_id", o.xsens_group_counter_id, max);
-  if (ids.quaternion == ids.sample_time || ids.quaternion == ids.group_counter || ids.sample_time == ids.group_counter)
-    throw std::invalid_argument("xsens_quaternion_id, xsens_sample_time_id and xsens_group_counter_id must differ");
+  ids.quaternion = parse_can_id_option("xsens_quaternion_id", read.text("xsens_quaternion_id"), max);
+  ids.sample_time = parse_can_id_option("xsens_sample_time_id", read.text("xsens_sample_time_id"), max);
+  ids.group_counter = parse_can_id_option("xsens_group_counter_id", read.text("xsens_group_counter_id"), max);
+  if (ids.quaternion == ids.sample_time || ids.quaternion == ids.group_counter || ids.sample_time == ids.group_counter) {
+    // Blame a key that was given (the defaults differ among themselves).
+    const char* key = read.has("xsens_quaternion_id") ? "xsens_quaternion_id"
+                      : read.has("xsens_sample_time_id") ? "xsens_sample_time_id"
+                                                         : "xsens_group_counter_id";
+    throw OptionError(key, "xsens_quaternion_id, xsens_sample_time_id and xsens_group_counter_id must differ");
+  }
+  const std::string unit = read.text("xsens_sample_time_unit");
   double tick = 0;
-  if (o.xsens_sample_time_unit == "100us")
+  if (unit == "100us")
     tick = 1e-4;
-  else if (o.xsens_sample_time_unit == "1us")
+  else if (unit == "1us")
     tick = 1e-6;
   else
-    throw std::invalid_argument("xsens_sample_time_unit: \"" + o.xsens_sample_time_unit + "\" is not \"100us\" or \"1us\"");
+    throw OptionError("xsens_sample_time_unit", "\"" + unit + "\" is not \"100us\" or \"1us\"");
   return std::make_unique<XsensCanDecoder>(ids, tick);
 }
 

@@ -256,7 +256,11 @@ class XsensDecoder final : public Decoder {
 
 }  // namespace
 
-std::unique_ptr<Decoder> make_xsens_decoder(const DecoderOptions& /*options*/) {
+const DecoderEntry kXsensDecoder{"xsens", "Xsens MTi series over a UART: Xbus MTData2 with a quaternion", {},
+                                 make_xsens_decoder};
+
+std::unique_ptr<Decoder> make_xsens_decoder(const OptionMap& options) {
+  (void)OptionReader({}, options);  // it reads none: refuses any
   return std::make_unique<XsensDecoder>();
 }
 

@@ -246,17 +246,30 @@ class YostDecoder final : public Decoder {
 
 }  // namespace
 
-std::unique_ptr<Decoder> make_yost_decoder(const DecoderOptions& options) {
+namespace {
+constexpr OptionSpec kOptions[] = {
+    {"yost_header", OptionType::IntegerOrString, "0x4F",
+     "the wired response header bitfield set with command 221; needs success 0x01, checksum 0x08, data length 0x40"},
+    {"yost_data_length", OptionType::IntegerOrString, "16",
+     "data bytes per streamed packet (16..255); slot 0 must be the tared quaternion, later bytes are skipped"},
+};
+}  // namespace
+
+const DecoderEntry kYostDecoder{"yost", "Yost Labs 3-Space: streamed tared quaternion with the wired response header",
+                                kOptions, make_yost_decoder};
+
+std::unique_ptr<Decoder> make_yost_decoder(const OptionMap& options) {
+  const OptionReader read(kOptions, options);
+  const std::string header = read.text("yost_header");
+  const std::string data_length = read.text("yost_data_length");
   std::uint32_t bits = 0;
-  if (!parse_unsigned(options.yost_header, bits) || (bits & ~kAllBits) != 0 ||
-      (bits & kRequiredBits) != kRequiredBits)
-    throw std::invalid_argument(
-        "yost_header: expected the command-221 bitfield (e.g. \"0x4F\") with success 0x01, checksum 0x08 and "
-        "data length 0x40 and no bit above 0x40, got \"" + options.yost_header + "\"");
+  if (!parse_unsigned(header, bits) || (bits & ~kAllBits) != 0 || (bits & kRequiredBits) != kRequiredBits)
+    throw OptionError("yost_header",
+                      "expected the command-221 bitfield (e.g. \"0x4F\") with success 0x01, checksum 0x08 and "
+                      "data length 0x40 and no bit above 0x40, got \"" + header + "\"");
   std::uint32_t length = 0;
-  if (!parse_unsigned(options.yost_data_length, length) || length < kQuaternionBytes || length > 255)
-    throw std::invalid_argument("yost_data_length: expected 16..255 (bytes per streamed packet), got \"" +
-                                options.yost_data_length + "\"");
+  if (!parse_unsigned(data_length, length) || length < kQuaternionBytes || length > 255)
+    throw OptionError("yost_data_length", "expected 16..255 (bytes per streamed packet), got \"" + data_length + "\"");
   return std::make_unique<YostDecoder>(bits, length);
 }
 

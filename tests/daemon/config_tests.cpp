@@ -14,7 +14,10 @@
 
 #include "../support/test_files.hpp"
 #include "posefair/daemon/config.hpp"
+#include "posefair/drivers/can_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
+#include "posefair/drivers/hid_sensor_orientation_decoder.hpp"
+#include "posefair/drivers/hid_vendor_layout_decoder.hpp"
 #include "posefair/drivers/replay_driver.hpp"
 
 namespace posefair::daemon {
@@ -22,6 +25,26 @@ namespace {
 
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
+
+// A decoder option as the configuration handed it on (text options arrive as text).
+std::string option_text(const drivers::OptionMap& options, const std::string& key) {
+  const auto it = options.find(key);
+  return it == options.end() ? std::string("(absent)") : std::get<std::string>(it->second);
+}
+
+// An expected message with the registries' lists in place of {can-protocols} ("a, b") and
+// {hid-protocols} ("'a', 'b'"), so that a new protocol changes no row.
+std::string with_registry_lists(std::string text) {
+  const auto join = [](const std::vector<std::string>& names, bool quoted) {
+    std::string list;
+    for (const std::string& n : names) list += (list.empty() ? "" : ", ") + (quoted ? "'" + n + "'" : n);
+    return list;
+  };
+  for (const auto& [placeholder, list] : {std::pair{std::string("{can-protocols}"), join(drivers::can_decoder_protocols(), false)},
+                                          std::pair{std::string("{hid-protocols}"), join(drivers::hid_decoder_protocols(), true)}})
+    for (std::size_t at = text.find(placeholder); at != std::string::npos; at = text.find(placeholder)) text.replace(at, placeholder.size(), list);
+  return text;
+}
 
 const std::filesystem::path kSourceDir = POSEFAIR_SOURCE_DIR;
 
@@ -388,12 +411,12 @@ driver = { type = "serial", device = "/dev/ttyUSB1", protocol = "witmotion", wit
   EXPECT_EQ(b.time_source, drivers::TimeSource::Auto);
   EXPECT_EQ(b.reconnect_min, 0.1);
   EXPECT_EQ(b.reconnect_max, 5.0);
-  EXPECT_EQ(b.decoder.witmotion_scalar, drivers::DecoderOptions{}.witmotion_scalar);
+  EXPECT_FALSE(b.decoder.contains("witmotion_scalar"));  // the decoder's default
   // No rate from a serial driver: the engine keeps its defaults.
   EXPECT_EQ(c.streams[1].engine.window, WindowConfig{}.window);
 
   if (witmotion) {
-    EXPECT_EQ(c.streams[2].driver.serial.decoder.witmotion_scalar, "last");
+    EXPECT_EQ(option_text(c.streams[2].driver.serial.decoder, "witmotion_scalar"), "last");
   }
 }
 
@@ -407,9 +430,9 @@ id = 2
 name = "yost"
 driver = { type = "serial", device = "/dev/ttyUSB1", protocol = "yost", yost_header = 0x4F, yost_data_length = 16 }
 )", "/virtual/options.toml");
-  EXPECT_EQ(c.streams[0].driver.serial.decoder.vectornav_unchecked, "accept");
-  EXPECT_EQ(c.streams[1].driver.serial.decoder.yost_header, "79");
-  EXPECT_EQ(c.streams[1].driver.serial.decoder.yost_data_length, "16");
+  EXPECT_EQ(option_text(c.streams[0].driver.serial.decoder, "vectornav_unchecked"), "accept");
+  EXPECT_EQ(option_text(c.streams[1].driver.serial.decoder, "yost_header"), "79");
+  EXPECT_EQ(option_text(c.streams[1].driver.serial.decoder, "yost_data_length"), "16");
 }
 
 TEST(Config, HidSourcesOfBothProtocolsAreParsed) {
@@ -445,11 +468,12 @@ driver = { type = "hid", device = "/dev/hidraw4", protocol = "hid-vendor", offse
   EXPECT_EQ(a.device.usb->pid, 0x5750);
   EXPECT_EQ(a.device.serial, "2053386B5650");
   EXPECT_EQ(a.device.device, "");
-  EXPECT_EQ(a.protocol, drivers::HidProtocol::Sensor);
-  EXPECT_EQ(a.sensor.component_order, "wxyz");
-  EXPECT_EQ(a.sensor.report_id, 8);
-  EXPECT_TRUE(a.sensor.conjugate);
-  EXPECT_EQ(a.sensor.timestamp_count_s, 1e-3);
+  EXPECT_EQ(a.protocol, "hid-sensor");
+  const drivers::HidSensorOrientationOptions as = drivers::hid_sensor_options(a.decoder);
+  EXPECT_EQ(as.component_order, "wxyz");
+  EXPECT_EQ(as.report_id, 8);
+  EXPECT_TRUE(as.conjugate);
+  EXPECT_EQ(as.timestamp_count_s, 1e-3);
   EXPECT_EQ(a.time_source, drivers::TimeSource::Receive);
   EXPECT_EQ(a.reconnect_min, 0.5);
   EXPECT_EQ(a.reconnect_max, 10.0);
@@ -457,22 +481,24 @@ driver = { type = "hid", device = "/dev/hidraw4", protocol = "hid-vendor", offse
   const HidSourceConfig& b = c.streams[1].driver.hid;
   EXPECT_EQ(b.device.device, "/dev/hidraw3");
   EXPECT_FALSE(b.device.usb);
-  EXPECT_EQ(b.protocol, drivers::HidProtocol::Vendor);
-  EXPECT_EQ(b.vendor.report_id, 2);
-  EXPECT_EQ(b.vendor.report_length, 20u);
-  EXPECT_EQ(b.vendor.type, drivers::HidVendorType::Float32);
-  EXPECT_TRUE(b.vendor.big_endian);
-  EXPECT_EQ(b.vendor.offset_bits, (std::array<std::uint32_t, 4>{32, 64, 96, 128}));
-  EXPECT_FALSE(b.vendor.w_first);
-  EXPECT_EQ(b.vendor.scale, 2.0);
+  EXPECT_EQ(b.protocol, "hid-vendor");
+  const drivers::HidVendorLayout bv = drivers::hid_vendor_layout(b.decoder);
+  EXPECT_EQ(bv.report_id, 2);
+  EXPECT_EQ(bv.report_length, 20u);
+  EXPECT_EQ(bv.type, drivers::HidVendorType::Float32);
+  EXPECT_TRUE(bv.big_endian);
+  EXPECT_EQ(bv.offset_bits, (std::array<std::uint32_t, 4>{32, 64, 96, 128}));
+  EXPECT_FALSE(bv.w_first);
+  EXPECT_EQ(bv.scale, 2.0);
   EXPECT_EQ(b.time_source, drivers::TimeSource::Auto);
 
   const HidSourceConfig& d = c.streams[2].driver.hid;
-  EXPECT_EQ(d.vendor.report_id, -1);  // the default: no report ID byte
-  EXPECT_EQ(d.vendor.type, drivers::HidVendorType::Int16);
-  EXPECT_EQ(d.vendor.offset_bits, (std::array<std::uint32_t, 4>{4, 20, 36, 52}));
-  EXPECT_TRUE(d.vendor.w_first);
-  EXPECT_EQ(d.vendor.scale, 1.0 / 16384.0);
+  const drivers::HidVendorLayout dv = drivers::hid_vendor_layout(d.decoder);
+  EXPECT_EQ(dv.report_id, -1);  // the default: no report ID byte
+  EXPECT_EQ(dv.type, drivers::HidVendorType::Int16);
+  EXPECT_EQ(dv.offset_bits, (std::array<std::uint32_t, 4>{4, 20, 36, 52}));
+  EXPECT_TRUE(dv.w_first);
+  EXPECT_EQ(dv.scale, 1.0 / 16384.0);
 }
 
 TEST(Config, SocketCanSourcesAndCandumpReplaysTakeTheirKeys) {
@@ -501,19 +527,19 @@ driver = { type = "replay", candump = "bus.log", interface = "can0", protocol = 
   const SocketCanSourceConfig& a = c.streams[0].driver.socketcan;
   EXPECT_EQ(a.interface, "can0");
   EXPECT_EQ(a.protocol, "posefair-can");
-  EXPECT_EQ(a.decoder.posefair_base_id, "516");
-  EXPECT_EQ(a.decoder.posefair_id_format, "extended");
+  EXPECT_EQ(option_text(a.decoder, "posefair_base_id"), "516");
+  EXPECT_EQ(option_text(a.decoder, "posefair_id_format"), "extended");
   EXPECT_TRUE(a.fd);
   EXPECT_EQ(a.time_source, drivers::TimeSource::Receive);
   EXPECT_EQ(a.reconnect_min, 0.2);
   EXPECT_EQ(a.reconnect_max, 2.0);
   const SocketCanSourceConfig& b = c.streams[1].driver.socketcan;
-  EXPECT_EQ(b.decoder.xsens_quaternion_id, "0x121");
-  EXPECT_EQ(b.decoder.xsens_sample_time_unit, "1us");
+  EXPECT_EQ(option_text(b.decoder, "xsens_quaternion_id"), "0x121");
+  EXPECT_EQ(option_text(b.decoder, "xsens_sample_time_unit"), "1us");
   EXPECT_FALSE(b.fd);
   EXPECT_EQ(b.reconnect_min, 0.1);
   EXPECT_EQ(b.reconnect_max, 5.0);
-  EXPECT_EQ(c.streams[2].driver.socketcan.decoder.dronecan_node_id, "42");
+  EXPECT_EQ(option_text(c.streams[2].driver.socketcan.decoder, "dronecan_node_id"), "42");
   ASSERT_EQ(c.streams[3].driver.type, DriverType::Replay);
   const ReplaySourceConfig& r = c.streams[3].driver.replay;
   EXPECT_EQ(r.candump, dir / "bus.log");
@@ -1214,7 +1240,7 @@ device = "/dev/hidraw0"
 id = 1
 name = "a"
 driver = { type = "hid", device = "/dev/hidraw0", protocol = "witmotion" }
-)", "stream[1].driver.protocol: expected one of 'hid-sensor', 'hid-vendor', got 'witmotion'", 4},
+)", "stream[1].driver.protocol: expected one of {hid-protocols}, got 'witmotion'", 4},
     {"hid: component_order not a permutation", R"([[stream]]
 id = 1
 name = "a"
@@ -1490,7 +1516,7 @@ toleranse_max = 0.002
 id = 1
 name = "a"
 driver = { type = "socketcan", interface = "can0", protocol = "xsens" }
-)", "stream[1].driver.protocol: unknown CAN protocol 'xsens' (known: dronecan-ahrs, posefair-can, xsens-can)", 4},
+)", "stream[1].driver.protocol: unknown CAN protocol 'xsens' (known: {can-protocols})", 4},
     {"socketcan: a bad identifier, judged by the decoder", R"([[stream]]
 id = 1
 name = "a"
@@ -1560,7 +1586,7 @@ driver = { type = "replay", candump = "bus.log", interface = "can0" }
 id = 1
 name = "a"
 driver = { type = "replay", candump = "bus.log", protocol = "posefair-cam" }
-)", "stream[1].driver.protocol: unknown CAN protocol 'posefair-cam' (known: dronecan-ahrs, posefair-can, xsens-can) (did you mean 'posefair-can'?)", 4},
+)", "stream[1].driver.protocol: unknown CAN protocol 'posefair-cam' (known: {can-protocols}) (did you mean 'posefair-can'?)", 4},
     {"replay: a CAN protocol without candump", R"([[stream]]
 id = 1
 name = "a"
@@ -1593,7 +1619,7 @@ TEST(Config, MalformedConfigsAreRefusedWithFileLineAndKey) {
       ADD_FAILURE() << "accepted";
     } catch (const ConfigError& e) {
       const std::string what = e.what();
-      EXPECT_THAT(what, HasSubstr(bad.expected));
+      EXPECT_THAT(what, HasSubstr(with_registry_lists(bad.expected)));
       EXPECT_EQ(e.file(), file.string());
       EXPECT_EQ(e.line(), bad.line) << what;
       if (bad.line > 0) {

@@ -7,9 +7,13 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <span>
+#include <string>
 #include <vector>
 
+#include "posefair/drivers/can_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
+#include "posefair/drivers/hid_report_decoder.hpp"
 
 namespace posefair::drivers {
 namespace {
@@ -21,8 +25,15 @@ struct Collect final : DecodedSink {
 
 TEST(DecoderRegistry, EveryProtocolOfTheIssueIsRegisteredUnderItsName) {
   const std::vector<std::string> expected = {"bno08x-rvc", "posefair", "vectornav", "witmotion", "xsens", "yost"};
-  EXPECT_EQ(decoder_protocols(), expected);
-  for (const std::string& name : expected) {
+  // The registry's own list (sorted, one name each) holds every one of them; a new protocol
+  // changes no line here.
+  const std::vector<std::string> names = decoder_protocols();
+  EXPECT_TRUE(std::is_sorted(names.begin(), names.end()));
+  EXPECT_EQ(std::adjacent_find(names.begin(), names.end()), names.end());
+  EXPECT_EQ(names.size(), decoder_entries().size());
+  for (const std::string& name : expected)
+    EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+  for (const std::string& name : names) {
     const auto d = make_decoder(name);
     ASSERT_NE(d, nullptr) << name;
     EXPECT_EQ(d->protocol(), name);
@@ -30,6 +41,44 @@ TEST(DecoderRegistry, EveryProtocolOfTheIssueIsRegisteredUnderItsName) {
   }
   EXPECT_EQ(make_decoder("nmea"), nullptr);
   EXPECT_EQ(make_decoder(""), nullptr);
+}
+
+// Every protocol of the three registries declares each key once, with a line of doc; an
+// undeclared key or a value of the wrong type is refused as an OptionError that names the key.
+template <class Entry, class Make>
+void check_declared_options(std::span<const Entry* const> entries, Make make) {
+  for (const Entry* e : entries) {
+    SCOPED_TRACE(std::string(e->name));
+    EXPECT_FALSE(e->description.empty());
+    for (std::size_t i = 0; i < e->options.size(); ++i) {
+      EXPECT_FALSE(e->options[i].doc.empty()) << e->options[i].name;
+      for (std::size_t j = 0; j < i; ++j) EXPECT_NE(e->options[i].name, e->options[j].name);
+    }
+    try {
+      make(*e, OptionMap{{"no_such_option", std::string("x")}});
+      ADD_FAILURE() << "an undeclared key was accepted";
+    } catch (const OptionError& err) {
+      EXPECT_EQ(err.key(), "no_such_option");
+    }
+    for (const OptionSpec& o : e->options) {
+      try {
+        make(*e, OptionMap{{std::string(o.name), o.type == OptionType::Boolean ? OptionValue{std::string("x")} : OptionValue{true}}});
+        ADD_FAILURE() << o.name << ": a value of the wrong type was accepted";
+      } catch (const OptionError& err) {
+        EXPECT_EQ(err.key(), o.name);
+      }
+    }
+  }
+}
+
+TEST(DecoderRegistry, EveryKindDeclaresItsOptions) {
+  check_declared_options(decoder_entries(), [](const DecoderEntry& e, const OptionMap& o) { (void)e.make(o); });
+  check_declared_options(can_decoder_entries(), [](const CanDecoderEntry& e, const OptionMap& o) { (void)e.make(o); });
+  check_declared_options(hid_decoder_entries(), [](const HidDecoderEntry& e, const OptionMap& o) { (void)e.configure(o); });
+  for (const DecoderEntry* e : decoder_entries()) EXPECT_NE(e->make({}), nullptr) << e->name;  // the defaults work
+  for (const CanDecoderEntry* e : can_decoder_entries()) EXPECT_NE(e->make({}), nullptr) << e->name;
+  EXPECT_EQ(can_decoder_protocols().size(), can_decoder_entries().size());
+  EXPECT_EQ(hid_decoder_protocols().size(), hid_decoder_entries().size());
 }
 
 // Random bytes with frame-start bytes of every protocol sprinkled in ('$', 0x55, 0xAA 0xAA,

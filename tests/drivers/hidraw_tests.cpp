@@ -3,6 +3,7 @@
 // once, counted, stopped promptly). Reading a real hidraw node needs the kernel's uhid: those
 // tests are tests/hw/hidraw_tests.cpp, run inside the VM.
 #include "posefair/drivers/hidraw_driver.hpp"
+#include "posefair/drivers/hid_vendor_layout_decoder.hpp"
 
 #include <gtest/gtest.h>
 
@@ -104,11 +105,12 @@ TEST(HidrawDriverOptions, RefusesWhatCannotWork) {
   EXPECT_THROW(make([](HidrawDriverOptions& o) { o.device.device.clear(); }), std::invalid_argument);
   EXPECT_THROW(make([](HidrawDriverOptions& o) { o.reconnect_min = 0.0; }), std::invalid_argument);
   EXPECT_THROW(make([](HidrawDriverOptions& o) { o.reconnect_max = 0.01; }), std::invalid_argument);
-  EXPECT_THROW(make([](HidrawDriverOptions& o) { o.sensor.component_order = "xyzz"; }), std::invalid_argument);
-  EXPECT_THROW(make([](HidrawDriverOptions& o) { o.sensor.report_id = 256; }), std::invalid_argument);
+  EXPECT_THROW(make([](HidrawDriverOptions& o) { o.decoder_options["component_order"] = std::string("xyzz"); }), std::invalid_argument);
+  EXPECT_THROW(make([](HidrawDriverOptions& o) { o.decoder_options["report_id"] = std::int64_t{256}; }), std::invalid_argument);
   EXPECT_THROW(make([](HidrawDriverOptions& o) {
-                 o.protocol = HidProtocol::Vendor;
-                 o.vendor.report_id = 0;
+                 o.protocol = "hid-vendor";
+                 o.decoder_options["offsets"] = std::vector<std::int64_t>{0, 2, 4, 6};
+                 o.decoder_options["report_id"] = std::int64_t{0};
                }),
                HidVendorLayoutError);
   EXPECT_NO_THROW(make([](HidrawDriverOptions&) {}));

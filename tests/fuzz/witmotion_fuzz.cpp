@@ -10,8 +10,8 @@
 #include "posefair/drivers/witmotion_decoder.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  posefair::drivers::DecoderOptions options;
-  options.witmotion_scalar = (size > 0 && (data[size - 1] & 1)) ? "last" : "first";
+  const posefair::drivers::OptionMap options{
+      {"witmotion_scalar", std::string((size > 0 && (data[size - 1] & 1)) ? "last" : "first")}};
   std::size_t cut = 0;
   for (std::size_t i = 0; i < size && i < 8; ++i) cut = cut * 131 + data[size - 1 - i];
   cut = size > 0 ? cut % (size + 1) : 0;

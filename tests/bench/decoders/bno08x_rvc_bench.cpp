@@ -36,7 +36,7 @@ Bytes make_stream(double corrupt_fraction) {
 }
 
 void run(benchmark::State& state, const Bytes& stream) {
-  auto decoder = make_bno08x_rvc_decoder(DecoderOptions{});
+  auto decoder = make_bno08x_rvc_decoder(OptionMap{});
   bench::decode_in_reads(state, *decoder, stream, static_cast<std::size_t>(state.range(0)));
 }
 

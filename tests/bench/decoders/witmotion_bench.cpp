@@ -56,7 +56,7 @@ Bytes make_stream(bool with_quaternion, double corrupt_fraction) {
 }
 
 void run(benchmark::State& state, const Bytes& stream) {
-  auto decoder = make_witmotion_decoder(DecoderOptions{});
+  auto decoder = make_witmotion_decoder(OptionMap{});
   bench::decode_in_reads(state, *decoder, stream, static_cast<std::size_t>(state.range(0)));
 }
 

@@ -36,7 +36,7 @@ void append(Bytes& out, const std::array<std::uint8_t, N>& frame) {
   out.insert(out.end(), frame.begin(), frame.end());
 }
 
-std::unique_ptr<Decoder> make() { return make_bno08x_rvc_decoder(DecoderOptions{}); }
+std::unique_ptr<Decoder> make() { return make_bno08x_rvc_decoder(OptionMap{}); }
 
 Decoded decode(const Bytes& stream) { return decode_chunks(make(), stream); }
 

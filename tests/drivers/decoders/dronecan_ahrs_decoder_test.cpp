@@ -39,7 +39,7 @@ std::uint32_t message_id(std::uint8_t node, std::uint8_t priority = 16) {
   return CanFrame::kEffFlag | (std::uint32_t{priority} << 24) | (1000u << 8) | node;
 }
 
-CanDecoded decode(const std::vector<CanFrame>& frames, const CanDecoderOptions& o = {}) {
+CanDecoded decode(const std::vector<CanFrame>& frames, const OptionMap& o = {}) {
   return decode_frames(make_dronecan_ahrs_decoder(o), frames);
 }
 
@@ -222,17 +222,17 @@ TEST(DroneCanAhrs, NodesAreReassembledApartAndCanBeChosen) {
     s.push_back(b[k]);
   }
   EXPECT_EQ(decode(s).samples.size(), 2u);
-  CanDecoderOptions o;
-  o.dronecan_node_id = "11";
+  OptionMap o;
+  o["dronecan_node_id"] = std::string("11");
   const CanDecoded r = decode(s, o);
   ASSERT_EQ(r.samples.size(), 1u);
   EXPECT_NEAR(std::abs(r.samples[0].orientation.x()), 1.0, 1e-3);
   EXPECT_EQ(r.frame_counters.foreign, a.size());
   auto d = make_dronecan_ahrs_decoder(o);
   expect_filters_pass(d->filters(), b, {a[0].can_id, message_id(11) & ~CanFrame::kEffFlag, (1001u << 8) | 11u | CanFrame::kEffFlag});
-  o.dronecan_node_id = "0";
+  o["dronecan_node_id"] = std::string("0");
   EXPECT_THROW(make_dronecan_ahrs_decoder(o), std::invalid_argument);
-  o.dronecan_node_id = "128";
+  o["dronecan_node_id"] = std::string("128");
   EXPECT_THROW(make_dronecan_ahrs_decoder(o), std::invalid_argument);
 }
 

@@ -22,7 +22,7 @@ CanFrame frame(std::uint32_t id, std::string_view bytes, bool extended = false) 
   return CanFrame::make(id, extended, hex(bytes));
 }
 
-CanDecoded decode(const std::vector<CanFrame>& frames, const CanDecoderOptions& o = {}) {
+CanDecoded decode(const std::vector<CanFrame>& frames, const OptionMap& o = {}) {
   return decode_frames(make_posefair_can_decoder(o), frames);
 }
 
@@ -86,9 +86,9 @@ TEST(PosefairCanDecoder, RoundTripsRandomSamples) {
   std::uniform_real_distribution<double> metres(-30.0, 30.0);
   for (int variant = 0; variant < 8; ++variant) {
     const bool with_time = variant & 1, with_position = variant & 2, extended = variant & 4;
-    CanDecoderOptions o;
-    o.posefair_base_id = extended ? "0x1ABCDE00" : "0x7F0";
-    o.posefair_id_format = extended ? "extended" : "standard";
+    OptionMap o;
+    o["posefair_base_id"] = std::string(extended ? "0x1ABCDE00" : "0x7F0");
+    o["posefair_id_format"] = std::string(extended ? "extended" : "standard");
     const std::uint32_t base = extended ? 0x1ABCDE00 : 0x7F0;
     std::vector<CanFrame> stream;
     std::vector<Quat> qs;
@@ -231,20 +231,20 @@ TEST(PosefairCanDecoder, OptionsAreCheckedAndTheRegistryKnowsIt) {
   EXPECT_EQ(make_can_decoder("no-such-protocol"), nullptr);
   const auto names = can_decoder_protocols();
   EXPECT_TRUE(std::find(names.begin(), names.end(), "posefair-can") != names.end());
-  CanDecoderOptions o;
-  o.posefair_base_id = "0x7FE";  // B + 2 would be 0x800
+  OptionMap o;
+  o["posefair_base_id"] = std::string("0x7FE");  // B + 2 would be 0x800
   EXPECT_THROW(make_posefair_can_decoder(o), std::invalid_argument);
-  o.posefair_base_id = "0x7FD";
+  o["posefair_base_id"] = std::string("0x7FD");
   EXPECT_NO_THROW(make_posefair_can_decoder(o));
-  o.posefair_base_id = "512";
+  o["posefair_base_id"] = std::string("512");
   const CanDecoded r = decode(kDocExample, o);
   EXPECT_EQ(r.samples.size(), 1u);
   for (const char* bad : {"", "0x", "-1", "12a", "0x1G", "99999999999"}) {
-    o.posefair_base_id = bad;
+    o["posefair_base_id"] = std::string(bad);
     EXPECT_THROW(make_posefair_can_decoder(o), std::invalid_argument) << bad;
   }
-  o.posefair_base_id = "0x200";
-  o.posefair_id_format = "long";
+  o["posefair_base_id"] = std::string("0x200");
+  o["posefair_id_format"] = std::string("long");
   EXPECT_THROW(make_posefair_can_decoder(o), std::invalid_argument);
 }
 

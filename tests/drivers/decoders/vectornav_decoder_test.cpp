@@ -40,11 +40,11 @@ std::span<const std::uint8_t> bytes_of(std::string_view s) {
 }
 
 // Feeds `stream` cut at the given chunk sizes (the rest as one last chunk).
-Decoded decode(std::string_view stream, const std::vector<std::size_t>& chunks = {}, const DecoderOptions& options = {}) {
+Decoded decode(std::string_view stream, const std::vector<std::size_t>& chunks = {}, const OptionMap& options = {}) {
   return decode_chunks(make_vectornav_decoder(options), bytes_of(stream), chunks);
 }
 
-Decoded decode_with(std::string_view stream, const DecoderOptions& options) { return decode(stream, {}, options); }
+Decoded decode_with(std::string_view stream, const OptionMap& options) { return decode(stream, {}, options); }
 
 double angle(const Quat& a, const Quat& b) { return so3::rotation_angle(a, b); }
 
@@ -317,8 +317,8 @@ TEST(VectorNavChecksumOff, XXIsRejectedByDefaultAndAcceptedOnRequest) {
   EXPECT_EQ(def.counters.frames, 0u);
   EXPECT_TRUE(def.samples.empty());
 
-  DecoderOptions accept;
-  accept.vectornav_unchecked = "accept";
+  OptionMap accept;
+  accept["vectornav_unchecked"] = std::string("accept");
   const Decoded acc = decode_with(unchecked + unchecked4, accept);
   EXPECT_EQ(acc.counters.frames, 2u);
   ASSERT_EQ(acc.samples.size(), 2u);
@@ -332,8 +332,8 @@ TEST(VectorNavChecksumOff, XXIsRejectedByDefaultAndAcceptedOnRequest) {
   const std::string body = "VNYPR,10.071,0.278,-2.026";
   EXPECT_EQ(decode("$" + body + "*" + vectornav_checksum(body, false) + "\r\n").samples.size(), 1u);
 
-  DecoderOptions wrong;
-  wrong.vectornav_unchecked = "yes";
+  OptionMap wrong;
+  wrong["vectornav_unchecked"] = std::string("yes");
   EXPECT_THROW(make_vectornav_decoder(wrong), std::invalid_argument);
 }
 

@@ -37,8 +37,8 @@ void append(Bytes& out, const std::array<std::uint8_t, N>& frame) {
 }
 
 std::unique_ptr<Decoder> make(const std::string& scalar = "first") {
-  DecoderOptions o;
-  o.witmotion_scalar = scalar;
+  OptionMap o;
+  o["witmotion_scalar"] = std::string(scalar);
   return make_witmotion_decoder(o);
 }
 
@@ -88,7 +88,7 @@ TEST(WitMotionDecoder, ScalarOptionIsFirstOrLast) {
   EXPECT_THROW(make("middle"), std::invalid_argument);
   EXPECT_THROW(make(""), std::invalid_argument);
   EXPECT_THROW(make("First"), std::invalid_argument);
-  EXPECT_EQ(DecoderOptions{}.witmotion_scalar, "first");
+  EXPECT_EQ(find_option(kWitMotionDecoder.options, "witmotion_scalar")->default_value, "first");  // the declared default
 }
 
 // Frames written by hand from the documented layout (see the top of this file).

@@ -25,7 +25,7 @@ CanFrame frame(std::uint32_t id, std::string_view bytes, bool extended = false) 
   return CanFrame::make(id, extended, hex(bytes));
 }
 
-CanDecoded decode(const std::vector<CanFrame>& frames, const CanDecoderOptions& o = {}) {
+CanDecoded decode(const std::vector<CanFrame>& frames, const OptionMap& o = {}) {
   return decode_frames(make_xsens_can_decoder(o), frames);
 }
 
@@ -58,8 +58,8 @@ TEST(XsensCanDecoder, TimeAndCounterGoWithTheNextQuaternion) {
   EXPECT_EQ(r.samples[0].frame_counter, 0x1234u);
   EXPECT_EQ(r.samples[1].flags, 0u);
   EXPECT_FALSE(r.samples[1].has_frame_counter);
-  CanDecoderOptions us;
-  us.xsens_sample_time_unit = "1us";
+  OptionMap us;
+  us["xsens_sample_time_unit"] = std::string("1us");
   const CanDecoded u = decode({frame(0x005, "00 01 E2 40"), frame(0x021, "7F FF 00 00 00 00 00 00")}, us);
   ASSERT_EQ(u.samples.size(), 1u);
   EXPECT_DOUBLE_EQ(u.samples[0].device_time, 0.123456);
@@ -119,11 +119,11 @@ TEST(XsensCanDecoder, MalformedFramesAreCounted) {
 }
 
 TEST(XsensCanDecoder, ConfiguredIdentifiersAndFormat) {
-  CanDecoderOptions o;
-  o.xsens_id_format = "extended";
-  o.xsens_quaternion_id = "0x18FF0021";
-  o.xsens_sample_time_id = "0x18FF0005";
-  o.xsens_group_counter_id = "0x18FF0006";
+  OptionMap o;
+  o["xsens_id_format"] = std::string("extended");
+  o["xsens_quaternion_id"] = std::string("0x18FF0021");
+  o["xsens_sample_time_id"] = std::string("0x18FF0005");
+  o["xsens_group_counter_id"] = std::string("0x18FF0006");
   const std::vector<CanFrame> stream = {frame(0x18FF0005, "00 00 00 0A", true), frame(0x18FF0021, "7F FF 00 00 00 00 00 00", true),
                                         frame(0x021, "7F FF 00 00 00 00 00 00")};
   const CanDecoded r = decode(stream, o);
@@ -163,14 +163,14 @@ TEST(XsensCanDecoder, ResetForgetsPendingTimeAndRollover) {
 }
 
 TEST(XsensCanDecoder, OptionsAreChecked) {
-  CanDecoderOptions o;
-  o.xsens_quaternion_id = "0x800";  // above 11 bits
+  OptionMap o;
+  o["xsens_quaternion_id"] = std::string("0x800");  // above 11 bits
   EXPECT_THROW(make_xsens_can_decoder(o), std::invalid_argument);
   o = {};
-  o.xsens_sample_time_id = "0x021";  // the same as the quaternion's
+  o["xsens_sample_time_id"] = std::string("0x021");  // the same as the quaternion's
   EXPECT_THROW(make_xsens_can_decoder(o), std::invalid_argument);
   o = {};
-  o.xsens_sample_time_unit = "10us";
+  o["xsens_sample_time_unit"] = std::string("10us");
   EXPECT_THROW(make_xsens_can_decoder(o), std::invalid_argument);
   EXPECT_EQ(make_can_decoder("xsens-can")->protocol(), "xsens-can");
 }

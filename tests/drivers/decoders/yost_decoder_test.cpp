@@ -31,11 +31,11 @@ using namespace ::posefair::testing;
 using Bytes = std::vector<std::uint8_t>;
 
 // Feeds `stream` cut at the given chunk sizes (the rest as one last chunk).
-Decoded decode(const Bytes& stream, const std::vector<std::size_t>& chunks = {}, const DecoderOptions& options = {}) {
+Decoded decode(const Bytes& stream, const std::vector<std::size_t>& chunks = {}, const OptionMap& options = {}) {
   return decode_chunks(make_yost_decoder(options), stream, chunks);
 }
 
-Decoded decode_with(const Bytes& stream, const DecoderOptions& options) { return decode(stream, {}, options); }
+Decoded decode_with(const Bytes& stream, const OptionMap& options) { return decode(stream, {}, options); }
 
 Bytes operator+(Bytes a, const Bytes& b) {
   a.insert(a.end(), b.begin(), b.end());
@@ -69,8 +69,8 @@ TEST(YostDecoder, HandWrittenPacketsDecodeToTheirValues) {
   EXPECT_LT((r.samples[1].orientation * Vec3::UnitX() - Vec3::UnitY()).norm(), 1e-7);
   EXPECT_DOUBLE_EQ(r.samples[1].device_time, 0xFFFFFFF0u * 1e-6);
 
-  DecoderOptions all;
-  all.yost_header = "0x7F";
+  OptionMap all;
+  all["yost_header"] = std::string("0x7F");
   const Decoded a = decode_with(kAllFields, all);
   ASSERT_EQ(a.samples.size(), 1u);
   EXPECT_DOUBLE_EQ(a.samples[0].device_time, 5e-6);
@@ -107,8 +107,8 @@ TEST(YostRoundTrip, RandomOrientationsEveryHeaderVariant) {
       truth.push_back(q);
       stream = stream + packet(q, static_cast<std::uint32_t>(1000 * k), f);
     }
-    DecoderOptions o;
-    o.yost_header = std::to_string(f.header);
+    OptionMap o;
+    o["yost_header"] = std::string(std::to_string(f.header));
     const Decoded r = decode_with(stream, o);
     ASSERT_EQ(r.samples.size(), truth.size()) << "header " << f.header;
     EXPECT_EQ(r.counters.skipped_bytes, 0u) << f.header;
@@ -127,8 +127,8 @@ TEST(YostRoundTrip, RandomOrientationsEveryHeaderVariant) {
 TEST(YostRoundTrip, FurtherStreamingSlotsAreSkipped) {
   YostPacketFields f;
   f.extra = Bytes(36, 0xAB);  // e.g. slot 1 = corrected sensor data (9 floats)
-  DecoderOptions o;
-  o.yost_data_length = "52";
+  OptionMap o;
+  o["yost_data_length"] = std::string("52");
   const Quat q = Quat(0.5, -0.5, 0.5, 0.5);
   const Decoded r = decode_with(packet(q, 1, f) + packet(q, 2, f), o);
   ASSERT_EQ(r.samples.size(), 2u);
@@ -257,9 +257,9 @@ TEST(YostFrames, FailureMalformedAndForeignPackets) {
 
 TEST(YostOptions, HeaderAndLengthAreValidated) {
   const auto make = [](const std::string& header, const std::string& length) {
-    DecoderOptions o;
-    o.yost_header = header;
-    o.yost_data_length = length;
+    OptionMap o;
+    o["yost_header"] = std::string(header);
+    o["yost_data_length"] = std::string(length);
     return make_yost_decoder(o);
   };
   EXPECT_NE(make("0x4F", "16"), nullptr);
@@ -324,9 +324,9 @@ TEST(YostCorpus, SeedFilesDecodeAsIntended) {
   ASSERT_EQ(wrap.samples.size(), 12u);
   for (std::size_t k = 0; k < wrap.samples.size(); ++k)
     EXPECT_NEAR(wrap.samples[k].device_time, (0xFFFF0000u + 20000.0 * static_cast<double>(k)) * 1e-6, 1e-9) << k;
-  DecoderOptions all;
-  all.yost_header = "0x7F";
-  all.yost_data_length = "20";
+  OptionMap all;
+  all["yost_header"] = std::string("0x7F");
+  all["yost_data_length"] = std::string("20");
   EXPECT_EQ(decode_with(file("all_fields_len20.bin"), all).samples.size(), 12u);
   const Decoded mixed = decode(file("mixed_garbage.bin"));
   EXPECT_EQ(mixed.samples.size(), 6u);

@@ -78,7 +78,7 @@ struct DaemonSettings {
 struct SocketCanSourceConfig {
   std::string interface;              // e.g. "can0"; for a candump replay empty = every interface
   std::string protocol;               // one of drivers::can_decoder_protocols()
-  drivers::CanDecoderOptions decoder; // posefair_*, xsens_*, dronecan_node_id
+  drivers::OptionMap decoder;         // the options given that the protocol declares
   bool fd = false;                    // also receive CAN FD frames
   drivers::TimeSource time_source = drivers::TimeSource::Auto;
   double reconnect_min = 0.1;         // s
@@ -116,20 +116,19 @@ struct SerialSourceConfig {
   drivers::SerialPortSpec port;       // device (absolute path) or usb (+ serial_number)
   drivers::SerialSettings settings;   // baud, data_bits, parity, stop_bits, flow_control
   std::string protocol;               // one of drivers::decoder_protocols()
-  drivers::DecoderOptions decoder;    // witmotion_scalar
+  drivers::OptionMap decoder;         // the options given that the protocol declares
   drivers::TimeSource time_source = drivers::TimeSource::Auto;
   double reconnect_min = 0.1;         // s
   double reconnect_max = 5.0;         // s, >= reconnect_min
 };
 
 // [stream.driver] with type = "hid": a HID device through hidraw (drivers/hidraw_driver.hpp),
-// opened by path or by USB id, its reports read by the hid-sensor or hid-vendor decoder. The
+// opened by path or by USB id, its reports read by a registered HID decoder. The
 // device need not exist at load: the driver waits for it.
 struct HidSourceConfig {
   drivers::HidDeviceSpec device;                 // device (absolute path) or usb (+ serial_number)
-  drivers::HidProtocol protocol = drivers::HidProtocol::Sensor;
-  drivers::HidSensorOrientationOptions sensor;   // component_order, report_id, conjugate, timestamp_count_s
-  drivers::HidVendorLayout vendor;               // report_id, report_length, type, byte_order, offsets, order, scale
+  std::string protocol;                          // one of drivers::hid_decoder_protocols()
+  drivers::OptionMap decoder;                    // the options given that the protocol declares
   drivers::TimeSource time_source = drivers::TimeSource::Auto;
   double reconnect_min = 0.1;                    // s
   double reconnect_max = 5.0;                    // s, >= reconnect_min

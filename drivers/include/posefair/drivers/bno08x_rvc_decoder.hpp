@@ -14,8 +14,11 @@ namespace posefair::drivers {
 
 inline constexpr std::size_t kBno08xRvcFrameSize = 19;  // 0xAA 0xAA, index, 6 int16, 3 reserved, checksum
 
+// The registry entry: name, description, no options, factory.
+extern const DecoderEntry kBno08xRvcDecoder;
+
 // The decoder (it reads no option). Samples carry the frame index, unwrapped, as frame_counter.
-std::unique_ptr<Decoder> make_bno08x_rvc_decoder(const DecoderOptions& options);
+std::unique_ptr<Decoder> make_bno08x_rvc_decoder(const OptionMap& options = {});
 
 // One frame: the angles times 100 and the accelerations (mg) rounded and saturated to int16,
 // the three bytes after the accelerations (motion intent, motion request, reserved on the

@@ -7,7 +7,8 @@
 // comes with the frame), no allocation after construction, never throws on any frame.
 //
 // One file per protocol in drivers/src/, opening with a comment that names its reference
-// document and quirks; can_decoder_registry.cpp lists them (one line per protocol).
+// document and quirks and declaring the options it reads (device_options.hpp) in its
+// CanDecoderEntry; can_decoder_registry.cpp lists the entries (one line per protocol).
 //
 // Counters. DecoderCounters keeps its meaning per valid protocol message:
 //   bytes          payload bytes of the data frames addressed to this decoder (ids it reads)
@@ -23,6 +24,7 @@
 // and CanFrameCounters counts the frames themselves, including those not addressed here.
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -52,27 +54,6 @@ struct CanFrameCounters {
   std::uint64_t remote = 0;    // remote (RTR) frames
   std::uint64_t errors = 0;    // error frames (kErrFlag); the driver logs their classes
   friend bool operator==(const CanFrameCounters&, const CanFrameCounters&) = default;
-};
-
-// Choices per protocol that the device's configuration decides (each decoder's comment says
-// which it reads and what its default is). Strings, as in DecoderOptions, keep the config layer
-// simple: numbers in decimal or 0x hex.
-struct CanDecoderOptions {
-  // posefair-can (docs/can-protocol.md): the base identifier B (frames B, B+1, B+2) and its
-  // format, "standard" (11-bit) or "extended" (29-bit).
-  std::string posefair_base_id = "0x200";
-  std::string posefair_id_format = "standard";
-  // xsens-can: the identifiers the MTi was set to send its messages with (MT Manager's CAN
-  // output configuration; defaults: the data identifiers), their format, and the unit of
-  // SampleTime: "100us" (10 kHz ticks, Xsens' current CAN documentation) or "1us".
-  std::string xsens_quaternion_id = "0x021";
-  std::string xsens_sample_time_id = "0x005";
-  std::string xsens_group_counter_id = "0x006";
-  std::string xsens_id_format = "standard";
-  std::string xsens_sample_time_unit = "100us";
-  // dronecan-ahrs: the source node id to read (1..127), or "any": every node's transfers
-  // (reassembled per node; the samples of several nodes would interleave in one stream).
-  std::string dronecan_node_id = "any";
 };
 
 class CanDecoder {
@@ -117,14 +98,27 @@ class CanDecoder {
   CanFrameCounters frame_counters_;
 };
 
-// The registry: nullptr for an unknown protocol name. Throws std::invalid_argument for an
-// option value the protocol does not accept (the message names the option).
-std::unique_ptr<CanDecoder> make_can_decoder(std::string_view protocol, const CanDecoderOptions& options = {});
+// A CAN protocol as the registry lists it: its name, one line saying what it reads, the
+// options it accepts, and the factory, which judges them (OptionError for a bad one).
+struct CanDecoderEntry {
+  std::string_view name;
+  std::string_view description;
+  std::span<const OptionSpec> options;
+  std::unique_ptr<CanDecoder> (*make)(const OptionMap& options);
+};
+
+// The registry: every CAN protocol, sorted by name.
+std::span<const CanDecoderEntry* const> can_decoder_entries();
+// nullptr for an unknown protocol name.
+const CanDecoderEntry* find_can_decoder(std::string_view protocol);
+// nullptr for an unknown protocol name. Throws OptionError for an option value the protocol does
+// not accept.
+std::unique_ptr<CanDecoder> make_can_decoder(std::string_view protocol, const OptionMap& options = {});
 // Every registered CAN protocol name, sorted.
 std::vector<std::string> can_decoder_protocols();
 
-// Reads an identifier option: decimal or 0x hex, at most `max`. Throws std::invalid_argument
-// naming `option` otherwise.
+// Reads an identifier option: decimal or 0x hex, at most `max`. Throws OptionError naming
+// `option` otherwise.
 std::uint32_t parse_can_id_option(std::string_view option, std::string_view text, std::uint32_t max);
 // Reads an id format option, "standard" or "extended" (true). Throws as above.
 bool parse_can_id_format_option(std::string_view option, std::string_view text);

@@ -18,7 +18,7 @@ namespace posefair::drivers {
 
 struct CandumpReplayOptions {
   std::string protocol;       // a CAN protocol name (can_decoder_protocols())
-  CanDecoderOptions decoder;  // its options
+  OptionMap decoder;          // its options
   std::string interface;      // only frames logged on this interface; empty: every interface
   std::uint32_t stream_id = 0;
   TimeSource time_source = TimeSource::Auto;

@@ -7,7 +7,8 @@
 // Every decoder resynchronises after garbage (it searches for the next frame start), verifies
 // the frame's checksum before using a byte of it, and counts what it saw. One file per
 // protocol in drivers/src/, opening with a comment that names the reference document and the
-// device's quirks; decoder_registry.cpp lists them (one line per protocol).
+// device's quirks and declaring the options it reads (device_options.hpp) in its DecoderEntry;
+// decoder_registry.cpp lists the entries (one line per protocol).
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "posefair/core/sample.hpp"
+#include "posefair/drivers/device_options.hpp"
 
 namespace posefair::drivers {
 
@@ -48,23 +50,6 @@ class DecodedSink {
   virtual void on_sample(const DecodedSample& sample) = 0;
 };
 
-// Choices the vendors' documents leave open, per protocol (each decoder's comment says which
-// it reads and what its default is). Strings keep the config layer simple.
-struct DecoderOptions {
-  // WitMotion 0x59: which of the four int16 components is the scalar: "first" (w x y z, the
-  // order of WitMotion's documents) or "last" (x y z w).
-  std::string witmotion_scalar = "first";
-  // VectorNav ASCII: sentences whose checksum field is "XX" (checksums disabled on the device):
-  // "reject" (counted as bad_checksum) or "accept" (used after strict content checks).
-  std::string vectornav_unchecked = "reject";
-  // Yost 3-Space: the wired response header bitfield the device was set to (command 221), as a
-  // number ("79" or "0x4F"); must include success (0x01), checksum (0x08) and data length (0x40).
-  std::string yost_header = "0x4F";
-  // Yost 3-Space: data bytes per streamed packet (the slots' total, 16..255); slot 0 must be
-  // command 0x00, the tared quaternion; bytes after its 16 are skipped.
-  std::string yost_data_length = "16";
-};
-
 class Decoder {
  public:
   virtual ~Decoder() = default;
@@ -94,9 +79,22 @@ class Decoder {
   bool resyncing_ = false;
 };
 
-// The registry: nullptr for an unknown protocol name. Throws std::invalid_argument for an
-// option value the protocol does not accept.
-std::unique_ptr<Decoder> make_decoder(std::string_view protocol, const DecoderOptions& options = {});
+// A serial protocol as the registry lists it: its name, one line saying what it reads, the
+// options it accepts, and the factory, which judges them (OptionError for a bad one).
+struct DecoderEntry {
+  std::string_view name;
+  std::string_view description;
+  std::span<const OptionSpec> options;
+  std::unique_ptr<Decoder> (*make)(const OptionMap& options);
+};
+
+// The registry: every serial protocol, sorted by name.
+std::span<const DecoderEntry* const> decoder_entries();
+// nullptr for an unknown protocol name.
+const DecoderEntry* find_decoder(std::string_view protocol);
+// nullptr for an unknown protocol name. Throws OptionError for an option value the protocol does
+// not accept.
+std::unique_ptr<Decoder> make_decoder(std::string_view protocol, const OptionMap& options = {});
 // Every registered protocol name, sorted.
 std::vector<std::string> decoder_protocols();
 

@@ -16,8 +16,11 @@ namespace posefair::drivers {
 inline constexpr std::uint16_t kDroneCanAhrsSolutionId = 1000;
 inline constexpr std::uint64_t kDroneCanAhrsSolutionSignature = 0x72A63A3C6F41FA9Bull;
 
-// Reads dronecan_node_id of CanDecoderOptions.
-std::unique_ptr<CanDecoder> make_dronecan_ahrs_decoder(const CanDecoderOptions& options = {});
+// The registry entry: name, description, options (dronecan_node_id), factory.
+extern const CanDecoderEntry kDroneCanAhrsDecoder;
+
+// Reads the option dronecan_node_id; throws OptionError for a bad one.
+std::unique_ptr<CanDecoder> make_dronecan_ahrs_decoder(const OptionMap& options = {});
 
 // The transfer CRC: CRC-16/CCITT-FALSE over the data type signature (8 bytes, least
 // significant first), then the payload.

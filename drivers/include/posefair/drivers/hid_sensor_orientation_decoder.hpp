@@ -70,6 +70,12 @@ HidOrientationLayout resolve_hid_orientation_layout(const HidReportDescriptor& d
 std::unique_ptr<HidReportDecoder> make_hid_sensor_orientation_decoder(const HidOrientationLayout& layout,
                                                                       const HidSensorOrientationOptions& options = {});
 
+// The registry entry: name, description, options (report_id, component_order, conjugate,
+// timestamp_count_s), and the factory that resolves each opened device's descriptor.
+extern const HidDecoderEntry kHidSensorDecoder;
+// The options as the configuration gives them. Throws OptionError for a bad one.
+HidSensorOrientationOptions hid_sensor_options(const OptionMap& options);
+
 // One input report as the device would send it: q (posefair's w, x, y, z; conjugated first if
 // options.conjugate) scaled by 10^-unit_exponent, rounded and clamped to each value's logical
 // range, in the layout's component order; the timestamp's raw counts if the layout has one;

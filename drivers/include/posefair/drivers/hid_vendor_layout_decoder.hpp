@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "posefair/core/sample.hpp"
+#include "posefair/drivers/device_options.hpp"
 #include "posefair/drivers/hid_report_decoder.hpp"
 
 namespace posefair::drivers {
@@ -37,12 +38,21 @@ struct HidVendorLayout {
   double norm_tolerance = 0.05;
 };
 
-// A layout that cannot be read. field() names the offending key ("report_id", "offset_bits[2]",
-// "scale", ...); what() is the whole message.
-class HidVendorLayoutError : public std::invalid_argument {
+// A layout that cannot be read. field() names the offending layout field ("report_id",
+// "offset_bits[2]", "scale", ...); what() is the whole message. As an OptionError, key() is the
+// configuration key to blame (hid_vendor_layout(OptionMap) gives offsets[3] for offset_bits[2]),
+// else the field.
+class HidVendorLayoutError : public OptionError {
  public:
   HidVendorLayoutError(std::string field, const std::string& message)
-      : std::invalid_argument("hid-vendor layout: " + field + ": " + message), field_(std::move(field)) {}
+      : OptionError(field, "hid-vendor layout: " + field + ": " + message, {}, "hid-vendor layout: " + field + ": " + message),
+        field_(std::move(field)) {}
+  // A problem blamed on configuration key `key`, in the words `message`.
+  HidVendorLayoutError(std::string field, std::string key, const std::string& message)
+      : OptionError(std::move(key), message, {}, "hid-vendor layout: " + field + ": " + message), field_(std::move(field)) {}
+  // The same error blamed on configuration key `key`: message() is e.what().
+  HidVendorLayoutError(const HidVendorLayoutError& e, std::string key)
+      : OptionError(std::move(key), e.what(), {}, e.what()), field_(e.field()) {}
   const std::string& field() const { return field_; }
 
  private:
@@ -56,6 +66,13 @@ void validate_hid_vendor_layout(const HidVendorLayout& layout);
 
 // Validates, then builds the decoder.
 std::unique_ptr<HidReportDecoder> make_hid_vendor_layout_decoder(const HidVendorLayout& layout);
+
+// The registry entry: name, description, options (report_id, report_length, value_type,
+// byte_order, offsets or offsets_bits, order, scale), factory.
+extern const HidDecoderEntry kHidVendorDecoder;
+// The layout the configuration's options describe, validated. Throws HidVendorLayoutError (an
+// OptionError) naming the configuration key for a bad one.
+HidVendorLayout hid_vendor_layout(const OptionMap& options);
 
 // Bytes each value takes (2, 4, 4, 8).
 std::uint32_t hid_vendor_type_bytes(HidVendorType type);

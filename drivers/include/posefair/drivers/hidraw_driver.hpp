@@ -8,10 +8,10 @@
 //     has this vendor:product and, when given, this serial number) and opens it read-only.
 //     While it is absent or refuses, it retries with exponential backoff (reconnect_min,
 //     doubling, up to reconnect_max).
-//   - on each open reads the report descriptor (HIDIOCGRDESCSIZE, HIDIOCGRDESC). hid-sensor
-//     builds its decoder from it (a descriptor without an orientation quaternion is refused
-//     like a device that cannot be opened: logged once, retried with backoff); hid-vendor uses
-//     the configured layout, the same decoder across reopens.
+//   - on each open reads the report descriptor (HIDIOCGRDESCSIZE, HIDIOCGRDESC) and has the
+//     protocol's HidDecoderFactory (hid_report_decoder.hpp) build the decoder for it; a device
+//     the protocol refuses (hid-sensor: no orientation quaternion in the descriptor) is treated
+//     like a device that cannot be opened: logged once, retried with backoff.
 //   - polls with a short timeout (read_timeout, 20 ms), so a stop request is seen within it;
 //     each read() is one report, its receive time CLOCK_MONOTONIC taken right after the read.
 //   - when the device goes away (POLLHUP/POLLERR, read error EIO/ENODEV/ENXIO, end of file)
@@ -29,10 +29,9 @@
 #include <string_view>
 #include <vector>
 
+#include "posefair/drivers/device_options.hpp"
 #include "posefair/drivers/driver.hpp"
 #include "posefair/drivers/hid_report_decoder.hpp"
-#include "posefair/drivers/hid_sensor_orientation_decoder.hpp"
-#include "posefair/drivers/hid_vendor_layout_decoder.hpp"
 #include "posefair/drivers/serial_driver.hpp"  // LogLevel, DriverLog
 #include "posefair/drivers/serial_port.hpp"    // UsbId, parse_usb_id
 #include "posefair/drivers/time_base.hpp"
@@ -66,14 +65,10 @@ struct HidDeviceSpec {
 std::vector<std::string> find_hidraw_nodes(const HidDeviceSpec& spec, const std::filesystem::path& sysfs_root = "/sys",
                                            const std::filesystem::path& dev_root = "/dev");
 
-enum class HidProtocol { Sensor, Vendor };
-std::string_view to_string(HidProtocol protocol);  // "hid-sensor", "hid-vendor"
-
 struct HidrawDriverOptions {
   HidDeviceSpec device;
-  HidProtocol protocol = HidProtocol::Sensor;
-  HidSensorOrientationOptions sensor;  // protocol Sensor
-  HidVendorLayout vendor;              // protocol Vendor
+  std::string protocol = "hid-sensor";  // HID decoder registry name (hid_report_decoder.hpp)
+  OptionMap decoder_options;             // its options
   std::uint32_t stream_id = 0;
   double reconnect_min = 0.1;  // s: the first wait after a failed open; finite, > 0
   double reconnect_max = 5.0;  // s: waits double up to this; >= reconnect_min
@@ -88,8 +83,8 @@ struct HidrawDriverOptions {
 
 class HidrawDriver final : public Driver {
  public:
-  // Throws std::invalid_argument: no device and no USB id, a bad vendor layout
-  // (HidVendorLayoutError), a bad component_order or report_id, bad backoff or time base.
+  // Throws std::invalid_argument: no device and no USB id, an unknown protocol, a bad decoder
+  // option (OptionError; hid-vendor: HidVendorLayoutError), bad backoff or time base.
   explicit HidrawDriver(HidrawDriverOptions options);
 
   std::string_view name() const override { return name_; }
@@ -115,7 +110,7 @@ class HidrawDriver final : public Driver {
 
   HidrawDriverOptions options_;
   std::string name_;
-  std::unique_ptr<HidReportDecoder> vendor_decoder_;  // protocol Vendor
+  std::unique_ptr<HidDecoderFactory> decoder_factory_;
 
   std::atomic<std::uint64_t> reports_{0}, samples_{0}, dropped_{0}, outages_{0}, reconnects_{0}, open_failures_{0},
       read_errors_{0}, fallbacks_{0};

@@ -11,8 +11,11 @@
 
 namespace posefair::drivers {
 
-// Reads posefair_base_id and posefair_id_format of CanDecoderOptions.
-std::unique_ptr<CanDecoder> make_posefair_can_decoder(const CanDecoderOptions& options = {});
+// The registry entry: name, description, options (posefair_base_id, posefair_id_format), factory.
+extern const CanDecoderEntry kPosefairCanDecoder;
+
+// Reads the options posefair_base_id and posefair_id_format; throws OptionError for a bad one.
+std::unique_ptr<CanDecoder> make_posefair_can_decoder(const OptionMap& options = {});
 
 // What a sender puts on the bus for one sample, in the order it sends it: the time frame (when
 // device_time_us is given), the position frame (when position is given; metres, rounded to mm),

@@ -11,8 +11,11 @@
 
 namespace posefair::drivers {
 
-// The decoder of both forms. Reads no option of DecoderOptions.
-std::unique_ptr<Decoder> make_posefair_serial_decoder(const DecoderOptions& options = {});
+// The registry entry: name, description, no options, factory.
+extern const DecoderEntry kPosefairSerialDecoder;
+
+// The decoder of both forms. Reads no option.
+std::unique_ptr<Decoder> make_posefair_serial_decoder(const OptionMap& options = {});
 
 // The text sentence "$PFQ,<time>,<w>,<x>,<y>,<z>[,<px>,<py>,<pz>]*HH\r\n", every number
 // written in its shortest round-trip form (a sentence decodes to exactly these doubles).

@@ -43,7 +43,7 @@ struct SerialDriverOptions {
   SerialPortSpec port;
   SerialSettings settings;
   std::string protocol;                // decoder registry name (decoder.hpp), used when `decoder` is null
-  DecoderOptions decoder_options;
+  OptionMap decoder_options;           // its options (decoder.hpp, device_options.hpp)
   std::unique_ptr<Decoder> decoder;    // an injected decoder (tests); takes the place of `protocol`
   std::uint32_t stream_id = 0;         // every sample's stream id
   double reconnect_min = 0.1;          // s: the first wait after a failed open; finite, > 0

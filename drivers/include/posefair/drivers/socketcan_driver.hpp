@@ -48,7 +48,7 @@ namespace posefair::drivers {
 struct SocketCanDriverOptions {
   std::string interface;               // e.g. "can0"; at most 15 characters (IFNAMSIZ − 1)
   std::string protocol;                // CAN decoder registry name, used when `decoder` is null
-  CanDecoderOptions decoder_options;
+  OptionMap decoder_options;           // its options (can_decoder.hpp, device_options.hpp)
   std::unique_ptr<CanDecoder> decoder; // an injected decoder (tests); takes the place of `protocol`
   bool fd = false;                     // also receive CAN FD frames (CAN_RAW_FD_FRAMES)
   std::uint32_t stream_id = 0;

@@ -15,10 +15,13 @@ namespace posefair::drivers {
 // (resyncs, skipped_bytes), never buffered further.
 inline constexpr std::size_t kVectorNavMaxSentence = 256;
 
-// The decoder. options.vectornav_unchecked: "reject" (default: a sentence whose checksum field
+// The registry entry: name, description, options (vectornav_unchecked), factory.
+extern const DecoderEntry kVectorNavDecoder;
+
+// The decoder. Option vectornav_unchecked: "reject" (default: a sentence whose checksum field
 // is "XX"/"XXXX", i.e. checksums disabled on the device, counts as bad_checksum) or "accept"
-// (used after strict content checks). Throws std::invalid_argument for any other value.
-std::unique_ptr<Decoder> make_vectornav_decoder(const DecoderOptions& options);
+// (used after strict content checks). Throws OptionError for any other value.
+std::unique_ptr<Decoder> make_vectornav_decoder(const OptionMap& options = {});
 
 // "$VNQMR,<x>,<y>,<z>,<w>,<mag x3>,<accel x3>,<gyro x3>*<CS>\r\n" as the device prints it:
 // quaternion components of q as given (scalar last, "%+.6f", not normalised, sign kept), fixed

@@ -13,10 +13,12 @@ namespace posefair::drivers {
 
 inline constexpr std::size_t kWitMotionFrameSize = 11;  // 0x55, type, 8 data bytes, checksum
 
-// The decoder. options.witmotion_scalar: "first" (default: q0 q1 q2 q3 = w x y z, as the
-// WitMotion documents number them) or "last" (x y z w). Throws std::invalid_argument for any
-// other value.
-std::unique_ptr<Decoder> make_witmotion_decoder(const DecoderOptions& options);
+// The registry entry: name, description, options (witmotion_scalar), factory.
+extern const DecoderEntry kWitMotionDecoder;
+
+// The decoder. Option witmotion_scalar: "first" (default: q0 q1 q2 q3 = w x y z, as the
+// WitMotion documents number them) or "last" (x y z w). Throws OptionError for any other value.
+std::unique_ptr<Decoder> make_witmotion_decoder(const OptionMap& options = {});
 
 // Any packet: 0x55, type, the 8 data bytes, the checksum (low byte of the sum of the first 10).
 std::array<std::uint8_t, kWitMotionFrameSize> encode_witmotion_frame(std::uint8_t type,

@@ -11,8 +11,11 @@
 
 namespace posefair::drivers {
 
-// Reads the xsens_* options of CanDecoderOptions.
-std::unique_ptr<CanDecoder> make_xsens_can_decoder(const CanDecoderOptions& options = {});
+// The registry entry: name, description, options (xsens_*), factory.
+extern const CanDecoderEntry kXsensCanDecoder;
+
+// Reads the xsens_* options; throws OptionError for a bad one.
+std::unique_ptr<CanDecoder> make_xsens_can_decoder(const OptionMap& options = {});
 
 // The frames an MTi sends for one sample with the default identifiers (standard format): the
 // GroupCounter (0x006) and SampleTime (0x005) messages when given, then the quaternion

@@ -11,8 +11,11 @@
 
 namespace posefair::drivers {
 
-// The MTData2 decoder. Reads no option of DecoderOptions.
-std::unique_ptr<Decoder> make_xsens_decoder(const DecoderOptions& options = {});
+// The registry entry: name, description, no options, factory.
+extern const DecoderEntry kXsensDecoder;
+
+// The MTData2 decoder. Reads no option.
+std::unique_ptr<Decoder> make_xsens_decoder(const OptionMap& options = {});
 
 // One whole Xbus MTData2 message (preamble through checksum) as an MTi sends it: PacketCounter
 // (0x1020) and SampleTimeFine (0x1060) when given, then Quaternion 0x2010 (float32, ENU; q's

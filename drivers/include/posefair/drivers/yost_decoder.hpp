@@ -25,10 +25,13 @@ enum YostHeaderBit : std::uint32_t {
 inline constexpr std::uint32_t kYostDefaultHeader =
     kYostSuccess | kYostTimestamp | kYostCommandEcho | kYostChecksum | kYostDataLength;
 
-// The decoder. options.yost_header (a number, decimal or 0x-hex; bits 0x01, 0x08 and 0x40
-// required, nothing above 0x40) and options.yost_data_length (16..255). Throws
-// std::invalid_argument for any other value.
-std::unique_ptr<Decoder> make_yost_decoder(const DecoderOptions& options);
+// The registry entry: name, description, options (yost_header, yost_data_length), factory.
+extern const DecoderEntry kYostDecoder;
+
+// The decoder. Options yost_header (a number, decimal or 0x-hex; bits 0x01, 0x08 and 0x40
+// required, nothing above 0x40) and yost_data_length (16..255). Throws OptionError for any
+// other value.
+std::unique_ptr<Decoder> make_yost_decoder(const OptionMap& options = {});
 
 // Header fields the encoder writes (each only if its bit is set in header).
 struct YostPacketFields {

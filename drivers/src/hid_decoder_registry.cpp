@@ -1,0 +1,41 @@
+// The HID decoder registry: one line per protocol (hid_report_decoder.hpp), as
+// decoder_registry.cpp is for the serial ones. A new protocol is one <protocol>_decoder.cpp
+// (with its HidDecoderEntry) plus one line here.
+#include <algorithm>
+
+#include "posefair/drivers/hid_report_decoder.hpp"
+#include "posefair/drivers/hid_sensor_orientation_decoder.hpp"
+#include "posefair/drivers/hid_vendor_layout_decoder.hpp"
+
+namespace posefair::drivers {
+namespace {
+
+// Sorted by name.
+const HidDecoderEntry* const kHidDecoders[] = {
+    &kHidSensorDecoder,
+    &kHidVendorDecoder,
+};
+
+}  // namespace
+
+std::span<const HidDecoderEntry* const> hid_decoder_entries() { return kHidDecoders; }
+
+const HidDecoderEntry* find_hid_decoder(std::string_view protocol) {
+  for (const HidDecoderEntry* e : kHidDecoders)
+    if (e->name == protocol) return e;
+  return nullptr;
+}
+
+std::unique_ptr<HidDecoderFactory> configure_hid_decoder(std::string_view protocol, const OptionMap& options) {
+  const HidDecoderEntry* e = find_hid_decoder(protocol);
+  return e ? e->configure(options) : nullptr;
+}
+
+std::vector<std::string> hid_decoder_protocols() {
+  std::vector<std::string> names;
+  for (const HidDecoderEntry* e : kHidDecoders) names.emplace_back(e->name);
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+}  // namespace posefair::drivers
