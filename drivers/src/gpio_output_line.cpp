@@ -3,7 +3,6 @@
 
 #include <gpiod.h>
 
-#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>

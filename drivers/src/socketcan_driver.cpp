@@ -215,13 +215,13 @@ std::string_view can_error_class_name(std::size_t bit) {
   return bit < kCanErrorClasses ? names[bit] : "unknown";
 }
 
-struct SocketCanDriver::Link {
+struct SocketCanDriver::Bus {
   CanSocket socket;
   std::vector<Received> batch = std::vector<Received>(kBatch);
 };
 
 SocketCanDriver::SocketCanDriver(SocketCanDriverOptions options)
-    : DeviceLinkDriver("socketcan", checked(options)), options_(std::move(options)), link_(std::make_unique<Link>()) {
+    : DeviceLinkDriver("socketcan", checked(options)), options_(std::move(options)), bus_(std::make_unique<Bus>()) {
   decoder_ = take_decoder(options_);
   filters_ = decoder_->filters();
   set_name(options_.name.empty() ? "socketcan:" + options_.interface + " (" + std::string(decoder_->protocol()) + ")"
@@ -270,7 +270,7 @@ void SocketCanDriver::count_error_frame(const CanFrame& frame) {
 }
 
 std::variant<DeviceLinkDriver::LinkOpened, DeviceLinkDriver::LinkOpenFailure> SocketCanDriver::open_link() {
-  if (const auto failure = link_->socket.open(options_.interface, filters_, options_.fd))
+  if (const auto failure = bus_->socket.open(options_.interface, filters_, options_.fd))
     return LinkOpenFailure{static_cast<unsigned>(failure->first), failure->first != OpenFailure::Other, "", failure->second};
   decoder_->reset();
   logged_classes_ = 0;
@@ -279,21 +279,21 @@ std::variant<DeviceLinkDriver::LinkOpened, DeviceLinkDriver::LinkOpenFailure> So
   o.where = options_.interface;
   o.details = ", protocol " + std::string(decoder_->protocol()) + (options_.fd ? ", CAN FD" : "") + ", " +
               std::to_string(filters_.size()) + " kernel filters, time source " + std::string(to_string(options_.time_source));
-  o.note = link_->socket.note();
+  o.note = bus_->socket.note();
   return o;
 }
 
 DeviceLinkDriver::LinkRead SocketCanDriver::read_link(int timeout_ms, SampleStamper& stamper) {
   LinkRead result;
-  pollfd p{link_->socket.fd(), POLLIN, 0};
+  pollfd p{bus_->socket.fd(), POLLIN, 0};
   const int ready = ::poll(&p, 1, timeout_ms);
   if (ready == 0 || (ready < 0 && errno == EINTR)) return result;  // look at the stop token again
 
-  std::vector<Received>& batch = link_->batch;
+  std::vector<Received>& batch = bus_->batch;
   std::size_t n = 0;
   int error = 0;
   while (n < kBatch) {
-    error = receive_frame(link_->socket.fd(), batch[n]);
+    error = receive_frame(bus_->socket.fd(), batch[n]);
     if (error == EINTR) continue;
     if (error != 0) break;
     ++n;
@@ -322,7 +322,7 @@ DeviceLinkDriver::LinkRead SocketCanDriver::read_link(int timeout_ms, SampleStam
 }
 
 void SocketCanDriver::close_link() {
-  link_->socket.close();
+  bus_->socket.close();
   decoder_->reset();  // partial transfers must not merge with frames from the new socket
 }
 

@@ -14,8 +14,7 @@
 // held by another consumer (EBUSY) or a chip that goes away never stops the stream: samples
 // pass unpaired, the failure is logged once per reason, and the request is retried with the
 // reconnect backoff (reconnect_backoff.hpp: reconnect_min doubling to reconnect_max) on later
-// pushes. Nothing here runs on the engine
-// or publisher threads.
+// pushes. Nothing here runs on the engine or publisher threads.
 #include <atomic>
 #include <cstdint>
 #include <mutex>
@@ -65,7 +64,8 @@ class GpioLineHandle {
   gpiod_line* line_ = nullptr;
 };
 
-// reconnect_min, reconnect_max: the backoff between requests of the line (ReconnectSettings).
+// reconnect_min, reconnect_max: the backoff between requests of the line (ReconnectSettings;
+// the daemon's [stream.gpio] defaults are 0.1 s and 2 s).
 struct GpioDataReadyOptions : ReconnectSettings {
   std::string chip;
   GpioLineRef line;

@@ -85,8 +85,8 @@ class SocketCanDriver final : public DeviceLinkDriver {
   SocketCanDriverOptions options_;
   std::unique_ptr<CanDecoder> decoder_;
   std::vector<CanFilter> filters_;
-  struct Link;                   // the socket and the read batch (socketcan_driver.cpp)
-  std::unique_ptr<Link> link_;   // run()'s thread only
+  struct Bus;                  // the socket and the read batch (socketcan_driver.cpp)
+  std::unique_ptr<Bus> bus_;   // run()'s thread only
 
   std::atomic<std::uint64_t> frames_{0}, fd_frames_{0}, error_frames_{0}, bus_off_{0};
   std::array<std::atomic<std::uint64_t>, kCanErrorClasses> error_classes_{};
