@@ -133,8 +133,9 @@ constexpr std::string_view kEngineKeys[] = {
     "smoothing_t", "cutoff_hz", "rate_hz", "continuity", "lambda_r", "lambda_t", "variant",
     "epsilon_r", "epsilon_t", "bound",  "gap",       "unit_tolerance"};
 constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "overflow", "driver", "engine", "spline", "gpio"};
-constexpr std::string_view kGpioKeys[] = {"chip",          "data_ready_line", "edge",        "bias",        "tolerance_min",
-                                          "tolerance_max", "output_line",     "output_mode", "heartbeat_hz"};
+constexpr std::string_view kGpioKeys[] = {"chip",          "data_ready_line", "edge",        "bias",         "tolerance_min",
+                                          "tolerance_max", "output_line",     "output_mode", "heartbeat_hz", "reconnect_min",
+                                          "reconnect_max"};
 constexpr std::string_view kSplineKeys[] = {"publish_rate_hz", "bridge_gap", "order", "manifold", "velocity", "pose_interpolation"};
 // Each [stream.driver] type's own keys; a device type also takes the keys its protocols declare
 // (ProtocolKind below), which this file does not name.
@@ -822,7 +823,8 @@ class Parser {
                                              {"device", drivers::TimeSource::Device}});
   }
 
-  // reconnect_min and reconnect_max of a device source: the backoff between open attempts.
+  // reconnect_min and reconnect_max of a device source or GPIO lines: the backoff between open
+  // (or request) attempts.
   void parse_reconnect(const toml::table& t, const std::string& prefix, double& min, double& max) const {
     auto key = [&](std::string_view name) { return join_key(prefix, name); };
     const toml::node* min_node = t.get("reconnect_min");
@@ -1112,6 +1114,7 @@ class Parser {
     if (output) g.output = get_gpio_line(*output, key("output_line"));
     if (g.data_ready && g.output && g.data_ready->offset == g.output->offset && g.data_ready->name == g.output->name)
       fail(*output, key("output_line"), "is the data_ready_line too: a line is an input or an output");
+    parse_reconnect(t, prefix, g.reconnect_min, g.reconnect_max);
     // The input line's keys mean nothing without it, the output's nothing without an output.
     for (std::string_view k : {"edge", "bias", "tolerance_min", "tolerance_max"})
       if (const toml::node* n = t.get(k); n && !input) fail(*n, key(k), "needs data_ready_line");

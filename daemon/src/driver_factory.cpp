@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "posefair/drivers/candump_replay.hpp"
+#include "posefair/drivers/driver_log.hpp"
 #include "posefair/drivers/hidraw_driver.hpp"
 #include "posefair/drivers/replay_driver.hpp"
 #include "posefair/drivers/serial_driver.hpp"
@@ -214,6 +215,8 @@ MadeGpioLines make_gpio_lines(const StreamConfig& stream, drivers::SampleSink& n
       o.edge = g.edge;
       o.bias = g.bias;
       o.pairing = g.pairing;
+      o.reconnect_min = g.reconnect_min;
+      o.reconnect_max = g.reconnect_max;
       o.consumer = "posefaird:" + stream.name;
       o.log = to_spdlog(stream.name);
       made.data_ready = std::make_unique<drivers::GpioDataReadySink>(std::move(o), next);
@@ -224,6 +227,8 @@ MadeGpioLines make_gpio_lines(const StreamConfig& stream, drivers::SampleSink& n
       o.line = *g.output;
       o.mode = g.output_mode;
       o.heartbeat_hz = g.heartbeat_hz;
+      o.reconnect_min = g.reconnect_min;
+      o.reconnect_max = g.reconnect_max;
       o.consumer = "posefaird:" + stream.name + ":out";
       o.log = to_spdlog(stream.name);
       made.output = std::make_unique<drivers::GpioOutputLine>(std::move(o));

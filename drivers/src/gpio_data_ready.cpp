@@ -7,14 +7,13 @@
 #include <time.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <cerrno>
-#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <utility>
 
+#include "link_log_text.hpp"
 #include "monotonic_clock.hpp"
 
 namespace posefair::drivers {
@@ -66,6 +65,12 @@ std::string GpioLineHandle::open(const std::string& chip, const GpioLineRef& ref
   return {};
 }
 
+std::string GpioLineHandle::held_by() const {
+  ::gpiod_line_update(line_);
+  const char* holder = ::gpiod_line_consumer(line_);
+  return std::string(" (held by '") + (holder != nullptr ? holder : "?") + "')";
+}
+
 void GpioLineHandle::release() {
   if (line_ != nullptr && ::gpiod_line_is_requested(line_)) ::gpiod_line_release(line_);
   line_ = nullptr;
@@ -74,10 +79,8 @@ void GpioLineHandle::release() {
 }
 
 GpioDataReadySink::GpioDataReadySink(GpioDataReadyOptions options, SampleSink& next)
-    : options_(std::move(options)), next_(next), pairer_(options_.pairing), delay_(options_.retry_min) {
-  if (!(options_.retry_min > 0.0) || !std::isfinite(options_.retry_min) || !(options_.retry_max >= options_.retry_min) ||
-      !std::isfinite(options_.retry_max))
-    throw std::invalid_argument("GPIO data-ready: need 0 < retry_min <= retry_max (finite)");
+    : options_(std::move(options)), next_(next), pairer_(options_.pairing), backoff_(options_) {
+  validate(static_cast<const ReconnectSettings&>(options_), "GPIO data-ready");
   if (options_.chip.empty()) throw std::invalid_argument("GPIO data-ready: no chip");
   const std::string release = kernel_release();
   clock_ok_ = gpio_event_clock_is_monotonic(release);
@@ -109,11 +112,7 @@ void GpioDataReadySink::try_request(double now) {
     if (rc != 0) {
       const int e = errno;
       why = "cannot request " + describe() + ": " + std::strerror(e);
-      if (e == EBUSY) {
-        ::gpiod_line_update(handle_.line());
-        const char* holder = ::gpiod_line_consumer(handle_.line());
-        why += std::string(" (held by '") + (holder != nullptr ? holder : "?") + "')";
-      }
+      if (e == EBUSY) why += handle_.held_by();
     } else {
       fd_ = ::gpiod_line_event_get_fd(handle_.line());
       const int fl = ::fcntl(fd_, F_GETFL);
@@ -124,10 +123,9 @@ void GpioDataReadySink::try_request(double now) {
     pairer_.reset();  // edges from before the request are not ours
     held_.store(true, std::memory_order_release);
     if (options_.log)
-      options_.log(LogLevel::Info, "took GPIO " + describe() +
-                                       (attempts_ > 0 ? " after " + std::to_string(attempts_ + 1) + " attempts" : std::string()));
+      options_.log(LogLevel::Info, "took GPIO " + describe() + (attempts_ > 0 ? " after " + attempts_text(attempts_ + 1) : std::string()));
     attempts_ = 0;
-    delay_ = options_.retry_min;
+    backoff_.reset();
     logged_reason_.clear();
     return;
   }
@@ -137,13 +135,10 @@ void GpioDataReadySink::try_request(double now) {
   request_failures_.fetch_add(1, std::memory_order_relaxed);
   // One line per reason while waiting, not one per retry (the holder's name is part of it).
   if (why != logged_reason_ && options_.log) {
-    char backoff[64];
-    std::snprintf(backoff, sizeof backoff, "%g .. %g s", options_.retry_min, options_.retry_max);
-    options_.log(LogLevel::Warn, why + "; samples pass unpaired, retrying with backoff " + backoff);
+    options_.log(LogLevel::Warn, why + "; samples pass unpaired, retrying with backoff " + backoff_.describe());
     logged_reason_ = why;
   }
-  next_attempt_ = now + delay_;
-  delay_ = std::min(delay_ * 2.0, options_.retry_max);
+  next_attempt_ = now + backoff_.next();
 }
 
 bool GpioDataReadySink::drain() {
@@ -169,7 +164,7 @@ bool GpioDataReadySink::push(const Sample& sample) {
         const std::string why = std::strerror(errno);
         release();
         losses_.fetch_add(1, std::memory_order_relaxed);
-        next_attempt_ = monotonic_seconds() + options_.retry_min;
+        next_attempt_ = monotonic_seconds() + options_.reconnect_min;
         if (options_.log)
           options_.log(LogLevel::Warn, "lost GPIO " + describe() + " (" + why + "); samples pass unpaired, retrying");
       } else {

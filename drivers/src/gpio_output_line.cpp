@@ -3,7 +3,6 @@
 
 #include <gpiod.h>
 
-#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -13,14 +12,15 @@
 #include <stdexcept>
 #include <utility>
 
+#include "link_log_text.hpp"
+
 namespace posefair::drivers {
 
 GpioOutputLine::GpioOutputLine(GpioOutputOptions options) : options_(std::move(options)) {
   if (options_.chip.empty()) throw std::invalid_argument("GPIO output: no chip");
   if (!(options_.heartbeat_hz > 0.0) || !std::isfinite(options_.heartbeat_hz))
     throw std::invalid_argument("GPIO output: heartbeat_hz must be finite and > 0");
-  if (!(options_.retry_min > 0.0) || !(options_.retry_max >= options_.retry_min) || !std::isfinite(options_.retry_max))
-    throw std::invalid_argument("GPIO output: need 0 < retry_min <= retry_max (finite)");
+  validate(static_cast<const ReconnectSettings&>(options_), "GPIO output");
 }
 
 GpioOutputLine::~GpioOutputLine() { stop(); }
@@ -64,7 +64,7 @@ void GpioOutputLine::run(std::stop_token stop) {
     if (options_.log) options_.log(l, s);
   };
 
-  double delay = options_.retry_min;
+  ReconnectBackoff backoff(options_);
   std::string logged;
   std::uint64_t attempts = 0;
   while (!stop.stop_requested()) {
@@ -72,27 +72,21 @@ void GpioOutputLine::run(std::stop_token stop) {
     if (why.empty() && ::gpiod_line_request_output(handle_.line(), options_.consumer.c_str(), 0) != 0) {
       const int e = errno;
       why = "cannot request GPIO output " + describe() + ": " + std::strerror(e);
-      if (e == EBUSY) {
-        ::gpiod_line_update(handle_.line());
-        const char* holder = ::gpiod_line_consumer(handle_.line());
-        why += std::string(" (held by '") + (holder != nullptr ? holder : "?") + "')";
-      }
+      if (e == EBUSY) why += handle_.held_by();
     }
     if (why.empty()) break;
     handle_.release();
     ++attempts;
     if (why != logged) {
-      log(LogLevel::Warn, why + "; retrying with backoff");
+      log(LogLevel::Warn, why + "; retrying with backoff " + backoff.describe());
       logged = why;
     }
-    wait_until(Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(delay)));
-    delay = std::min(delay * 2.0, options_.retry_max);
+    wait_until(Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(backoff.next())));
   }
   if (stop.stop_requested()) return;
   value_ = 0;
   held_.store(true, std::memory_order_release);
-  log(LogLevel::Info, "took GPIO output " + describe() +
-                          (attempts > 0 ? " after " + std::to_string(attempts + 1) + " attempts" : std::string()));
+  log(LogLevel::Info, "took GPIO output " + describe() + (attempts > 0 ? " after " + attempts_text(attempts + 1) : std::string()));
   if (options_.mode != GpioOutputMode::Heartbeat) return;  // the publisher toggles it
   // A square wave of heartbeat_hz (what a scope shows): two toggles per period.
   const auto period =

@@ -1,6 +1,7 @@
 #pragma once
-// The few words the device drivers' log lines share ("waited 3.0 s", "backoff 0.1 s .. 5 s",
-// "12 attempts"), so that serial, SocketCAN and hidraw read alike. Private to drivers/src.
+// The few words the link log lines share ("waited 3.0 s", "backoff 0.1 s .. 5 s", "12
+// attempts"), so that the device links (device_link_driver.cpp) and the GPIO lines read alike.
+// Private to drivers/src.
 #include <cstdint>
 #include <cstdio>
 #include <string>

@@ -1,5 +1,5 @@
-// The SocketCAN driver: socket, filters, timestamps, error frames and reconnection; see
-// socketcan_driver.hpp. Kernel interface: linux/can.h, linux/can/raw.h, linux/can/error.h
+// The SocketCAN driver: socket, filters, timestamps and error frames behind the device link;
+// see socketcan_driver.hpp. Kernel interface: linux/can.h, linux/can/raw.h, linux/can/error.h
 // (Documentation/networking/can.rst).
 #include "posefair/drivers/socketcan_driver.hpp"
 
@@ -15,16 +15,12 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
-#include <cmath>
-#include <condition_variable>
-#include <cstdio>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 #include <vector>
 
-#include "link_log_text.hpp"
 #include "monotonic_clock.hpp"
 #include "sample_stamper.hpp"
 
@@ -35,12 +31,6 @@ static_assert(CanFrame::kEffFlag == CAN_EFF_FLAG && CanFrame::kRtrFlag == CAN_RT
 static_assert(CanFrame::kFdBrs == CANFD_BRS && CanFrame::kFdEsi == CANFD_ESI);
 static_assert(CanFrame::kMaxFd == CANFD_MAX_DLEN && CanFrame::kMaxClassic == CAN_MAX_DLEN);
 
-double clock_seconds(clockid_t clock) {
-  timespec ts{};
-  ::clock_gettime(clock, &ts);
-  return seconds_of(ts);
-}
-
 std::string errno_text(int e) { return std::strerror(e); }
 
 // CLOCK_REALTIME − CLOCK_MONOTONIC, read between two monotonic reads (the midpoint is the best
@@ -50,10 +40,11 @@ struct ClockOffset {
   double monotonic_now = 0.0;
 };
 ClockOffset measure_clock_offset() {
-  const double m1 = clock_seconds(CLOCK_MONOTONIC);
-  const double r = clock_seconds(CLOCK_REALTIME);
-  const double m2 = clock_seconds(CLOCK_MONOTONIC);
-  return {r - 0.5 * (m1 + m2), m2};
+  const double m1 = monotonic_seconds();
+  timespec ts{};
+  ::clock_gettime(CLOCK_REALTIME, &ts);
+  const double m2 = monotonic_seconds();
+  return {seconds_of(ts) - 0.5 * (m1 + m2), m2};
 }
 
 std::unique_ptr<CanDecoder> take_decoder(SocketCanDriverOptions& o) {
@@ -67,9 +58,16 @@ std::unique_ptr<CanDecoder> take_decoder(SocketCanDriverOptions& o) {
   return d;
 }
 
-// Why an open failed; each is logged once per wait.
+const SocketCanDriverOptions& checked(const SocketCanDriverOptions& o) {
+  if (o.interface.empty()) throw std::invalid_argument("socketcan: give an interface, e.g. can0");
+  if (o.interface.size() >= IFNAMSIZ)
+    throw std::invalid_argument("socketcan: interface name '" + o.interface + "' is longer than " +
+                                std::to_string(IFNAMSIZ - 1) + " characters");
+  return o;
+}
+
+// Why an open failed; each is logged once per wait. NoInterface and Down are "absent".
 enum class OpenFailure { NoInterface, Down, Other };
-constexpr unsigned bit_of(OpenFailure f) { return 1u << static_cast<unsigned>(f); }
 
 // An open raw CAN socket bound to one interface, or why there is none.
 class CanSocket {
@@ -206,9 +204,7 @@ const char* state_name(int s) {
   }
 }
 
-constexpr std::size_t kBatch = 64;        // frames read before their timestamps are converted
-constexpr int kTransientLimit = 10;       // consecutive read errors before the socket is reopened
-constexpr double kStableConnection = 1.0; // s: a connection this long resets the backoff when lost
+constexpr std::size_t kBatch = 64;  // frames read before their timestamps are converted
 
 }  // namespace
 
@@ -219,68 +215,24 @@ std::string_view can_error_class_name(std::size_t bit) {
   return bit < kCanErrorClasses ? names[bit] : "unknown";
 }
 
-SocketCanDriver::SocketCanDriver(SocketCanDriverOptions options) : options_(std::move(options)) {
-  if (options_.interface.empty()) throw std::invalid_argument("socketcan: give an interface, e.g. can0");
-  if (options_.interface.size() >= IFNAMSIZ)
-    throw std::invalid_argument("socketcan: interface name '" + options_.interface + "' is longer than " +
-                                std::to_string(IFNAMSIZ - 1) + " characters");
-  if (!(options_.reconnect_min > 0.0) || !std::isfinite(options_.reconnect_min))
-    throw std::invalid_argument("socketcan: reconnect_min must be finite and > 0");
-  if (!(options_.reconnect_max >= options_.reconnect_min) || !std::isfinite(options_.reconnect_max))
-    throw std::invalid_argument("socketcan: reconnect_max must be finite and >= reconnect_min");
-  if (!(options_.read_timeout > 0.0 && options_.read_timeout <= 0.05))
-    throw std::invalid_argument("socketcan: read_timeout must be in (0, 0.05] s");
-  const TimeBase check(options_.time_source, options_.time_base);  // throws for bad time base options
+struct SocketCanDriver::Bus {
+  CanSocket socket;
+  std::vector<Received> batch = std::vector<Received>(kBatch);
+};
+
+SocketCanDriver::SocketCanDriver(SocketCanDriverOptions options)
+    : DeviceLinkDriver("socketcan", checked(options)), options_(std::move(options)), bus_(std::make_unique<Bus>()) {
   decoder_ = take_decoder(options_);
-  name_ = options_.name.empty() ? "socketcan:" + options_.interface + " (" + std::string(decoder_->protocol()) + ")"
-                                : options_.name;
+  filters_ = decoder_->filters();
+  set_name(options_.name.empty() ? "socketcan:" + options_.interface + " (" + std::string(decoder_->protocol()) + ")"
+                                 : options_.name);
 }
 
-void SocketCanDriver::log(LogLevel level, const std::string& message) const {
-  if (options_.log) options_.log(level, message);
-}
-
-DecoderCounters SocketCanDriver::decoder_counters() const {
-  std::lock_guard lock(snapshot_mutex_);
-  return decoder_snapshot_;
-}
+SocketCanDriver::~SocketCanDriver() = default;
 
 CanFrameCounters SocketCanDriver::frame_counters() const {
-  std::lock_guard lock(snapshot_mutex_);
+  std::lock_guard lock(frame_mutex_);
   return frame_snapshot_;
-}
-
-TimeBaseCounters SocketCanDriver::time_base_counters() const {
-  std::lock_guard lock(snapshot_mutex_);
-  return time_base_snapshot_;
-}
-
-std::optional<DeviceHealth> SocketCanDriver::health() const {
-  DeviceHealth h;
-  h.connected = connected();
-  h.outages = outages();
-  h.reconnects = reconnects();
-  h.open_failures = open_failures();
-  h.read_errors = read_errors();
-  const DecoderCounters d = decoder_counters();
-  h.frames = d.frames;
-  h.bad_frames = d.bad_checksum + d.malformed;
-  h.resyncs = d.resyncs;
-  h.skipped_bytes = d.skipped_bytes;
-  h.device_time_trusted = trusted_.load(std::memory_order_relaxed);
-  h.time_fallbacks = fallbacks_.load(std::memory_order_relaxed);
-  return h;
-}
-
-void SocketCanDriver::publish_snapshots(const TimeBase& time_base) {
-  {
-    std::lock_guard lock(snapshot_mutex_);
-    decoder_snapshot_ = decoder_->counters();
-    frame_snapshot_ = decoder_->frame_counters();
-    time_base_snapshot_ = time_base.counters();
-  }
-  fallbacks_.store(time_base.counters().fallbacks, std::memory_order_relaxed);
-  trusted_.store(time_base.trusted(), std::memory_order_relaxed);
 }
 
 void SocketCanDriver::count_error_frame(const CanFrame& frame) {
@@ -317,135 +269,61 @@ void SocketCanDriver::count_error_frame(const CanFrame& frame) {
   log(state >= kPassive ? LogLevel::Error : LogLevel::Warn, line);
 }
 
-void SocketCanDriver::run(std::stop_token stop, SampleSink& sink) {
-  using Clock = std::chrono::steady_clock;
-  std::mutex wait_mutex;
-  std::condition_variable_any wake;  // nobody notifies it: it wakes at the deadline or on stop
-  auto wait = [&](double seconds) {
-    std::unique_lock lock(wait_mutex);
-    wake.wait_for(lock, stop, std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds)),
-                  [] { return false; });
-  };
+std::variant<DeviceLinkDriver::LinkOpened, DeviceLinkDriver::LinkOpenFailure> SocketCanDriver::open_link() {
+  if (const auto failure = bus_->socket.open(options_.interface, filters_, options_.fd))
+    return LinkOpenFailure{static_cast<unsigned>(failure->first), failure->first != OpenFailure::Other, "", failure->second};
+  decoder_->reset();
+  logged_classes_ = 0;
+  LinkOpened o;
+  o.path = options_.interface;
+  o.where = options_.interface;
+  o.details = ", protocol " + std::string(decoder_->protocol()) + (options_.fd ? ", CAN FD" : "") + ", " +
+              std::to_string(filters_.size()) + " kernel filters, time source " + std::string(to_string(options_.time_source));
+  o.note = bus_->socket.note();
+  return o;
+}
 
-  const int timeout_ms = std::max(1, static_cast<int>(std::lround(options_.read_timeout * 1000.0)));
-  TimeBase time_base(options_.time_source, options_.time_base);
-  std::uint64_t sequence = 0;  // from 0 per run(), across reconnects
-  SampleStamper stamper(options_.stream_id, time_base, sink, sequence, samples_, dropped_);
-  CanSocket socket;
-  const std::vector<CanFilter> filters = decoder_->filters();
-  std::vector<Received> batch(kBatch);
+DeviceLinkDriver::LinkRead SocketCanDriver::read_link(int timeout_ms, SampleStamper& stamper) {
+  LinkRead result;
+  pollfd p{bus_->socket.fd(), POLLIN, 0};
+  const int ready = ::poll(&p, 1, timeout_ms);
+  if (ready == 0 || (ready < 0 && errno == EINTR)) return result;  // look at the stop token again
 
-  const std::string backoff = backoff_text(options_.reconnect_min) + " .. " + backoff_text(options_.reconnect_max);
-  bool lost = false;
-  double waiting_since = clock_seconds(CLOCK_MONOTONIC);
-  std::uint64_t attempts = 0;
-  double delay = options_.reconnect_min;
-  unsigned logged_kinds = 0;
-  int transient_streak = 0;
-  double opened_at = 0.0;
-
-  auto lose = [&](const std::string& why) {
-    socket.close();
-    decoder_->reset();
-    connected_.store(false, std::memory_order_release);
-    outages_.fetch_add(1, std::memory_order_relaxed);
-    publish_snapshots(time_base);
-    log(LogLevel::Warn, "lost interface " + options_.interface + " (" + why + "); reopening with backoff " + backoff);
-    lost = true;
-    waiting_since = clock_seconds(CLOCK_MONOTONIC);
-    attempts = 0;
-    logged_kinds = bit_of(OpenFailure::NoInterface) | bit_of(OpenFailure::Down);  // expected now: said above
-    transient_streak = 0;
-    if (waiting_since - opened_at >= kStableConnection) {
-      delay = options_.reconnect_min;
-    } else {
-      wait(delay);  // an interface that opens and fails at once: keep backing off
-      delay = std::min(delay * 2.0, options_.reconnect_max);
-    }
-  };
-
-  while (!stop.stop_requested()) {
-    if (!socket.is_open()) {
-      if (const auto failure = socket.open(options_.interface, filters, options_.fd)) {
-        open_failures_.fetch_add(1, std::memory_order_relaxed);
-        ++attempts;
-        if ((logged_kinds & bit_of(failure->first)) == 0) {  // one line per reason per wait
-          logged_kinds |= bit_of(failure->first);
-          log(failure->first == OpenFailure::Other ? LogLevel::Error : LogLevel::Warn,
-              "cannot open: " + failure->second + "; retrying with backoff " + backoff);
-        }
-        wait(delay);
-        delay = std::min(delay * 2.0, options_.reconnect_max);
-        continue;
-      }
-      const double waited = clock_seconds(CLOCK_MONOTONIC) - waiting_since;
-      if (lost) {
-        reconnects_.fetch_add(1, std::memory_order_relaxed);
-        log(LogLevel::Info, "reopened " + options_.interface + " after " + seconds_text(waited) + " and " +
-                                attempts_text(attempts + 1));
-      } else {
-        std::string line = "opened " + options_.interface + ", protocol " + std::string(decoder_->protocol()) +
-                           (options_.fd ? ", CAN FD" : "") + ", " + std::to_string(filters.size()) +
-                           " kernel filters, time source " + std::string(to_string(options_.time_source));
-        if (attempts > 0) line += " after " + seconds_text(waited) + " and " + attempts_text(attempts + 1);
-        log(LogLevel::Info, line);
-      }
-      if (!socket.note().empty()) log(LogLevel::Warn, socket.note());
-      lost = false;
-      attempts = 0;
-      opened_at = clock_seconds(CLOCK_MONOTONIC);
-      logged_kinds = 0;
-      logged_classes_ = 0;
-      transient_streak = 0;
-      decoder_->reset();
-      time_base.restart();
-      connected_.store(true, std::memory_order_release);
-      continue;
-    }
-
-    pollfd p{socket.fd(), POLLIN, 0};
-    const int ready = ::poll(&p, 1, timeout_ms);
-    if (ready == 0 || (ready < 0 && errno == EINTR)) continue;  // look at the stop token again
-
-    std::size_t n = 0;
-    int error = 0;
-    while (n < kBatch) {
-      error = receive_frame(socket.fd(), batch[n]);
-      if (error == EINTR) continue;
-      if (error != 0) break;
-      ++n;
-    }
-    if (n > 0) {
-      const ClockOffset offset = measure_clock_offset();  // after the reads: see the header
-      transient_streak = 0;
-      for (std::size_t i = 0; i < n; ++i) {
-        CanFrame& f = batch[i].frame;
-        f.timestamp = batch[i].realtime > 0.0
-                          ? std::min(batch[i].realtime - offset.realtime_minus_monotonic, offset.monotonic_now)
-                          : offset.monotonic_now;
-        frames_.fetch_add(1, std::memory_order_relaxed);
-        if (f.fd) fd_frames_.fetch_add(1, std::memory_order_relaxed);
-        if (f.error()) count_error_frame(f);
-        stamper.set_receive_time(f.timestamp);
-        decoder_->feed(f, stamper);
-      }
-      publish_snapshots(time_base);
-    }
-    if (error == 0 || error == EAGAIN || error == EWOULDBLOCK) continue;
-    if (interface_gone(error)) {
-      lose(error == ENETDOWN ? "interface down" : errno_text(error));
-      continue;
-    }
-    read_errors_.fetch_add(1, std::memory_order_relaxed);
-    if (transient_streak++ == 0) log(LogLevel::Warn, "read error: " + errno_text(error));
-    if (transient_streak < kTransientLimit) {
-      wait(options_.read_timeout);
-      continue;
-    }
-    lose("repeated read errors: " + errno_text(error));
+  std::vector<Received>& batch = bus_->batch;
+  std::size_t n = 0;
+  int error = 0;
+  while (n < kBatch) {
+    error = receive_frame(bus_->socket.fd(), batch[n]);
+    if (error == EINTR) continue;
+    if (error != 0) break;
+    ++n;
   }
-  socket.close();
-  connected_.store(false, std::memory_order_release);
+  if (n > 0) {
+    const ClockOffset offset = measure_clock_offset();  // after the reads: see the header
+    for (std::size_t i = 0; i < n; ++i) {
+      CanFrame& f = batch[i].frame;
+      f.timestamp = batch[i].realtime > 0.0
+                        ? std::min(batch[i].realtime - offset.realtime_minus_monotonic, offset.monotonic_now)
+                        : offset.monotonic_now;
+      frames_.fetch_add(1, std::memory_order_relaxed);
+      if (f.fd) fd_frames_.fetch_add(1, std::memory_order_relaxed);
+      if (f.error()) count_error_frame(f);
+      stamper.set_receive_time(f.timestamp);
+      decoder_->feed(f, stamper);
+    }
+    std::lock_guard lock(frame_mutex_);
+    frame_snapshot_ = decoder_->frame_counters();
+    result.decoded = true;
+  }
+  if (error == 0 || error == EAGAIN || error == EWOULDBLOCK) return result;
+  result.error = interface_gone(error) ? LinkRead::Error::Gone : LinkRead::Error::Transient;
+  result.message = error == ENETDOWN ? "interface down" : errno_text(error);
+  return result;
+}
+
+void SocketCanDriver::close_link() {
+  bus_->socket.close();
+  decoder_->reset();  // partial transfers must not merge with frames from the new socket
 }
 
 }  // namespace posefair::drivers

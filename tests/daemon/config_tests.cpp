@@ -668,6 +668,43 @@ gpio = { chip = "/dev/gpiochip1", output_line = 2 }
   EXPECT_EQ(o.pairing.tolerance_max, drivers::EdgePairingOptions{}.tolerance_max);
 }
 
+TEST(Config, TheGpioLinesTakeTheDeviceDriversReconnectKeys) {
+  const DaemonConfig c = parse_config(R"toml(
+[[stream]]
+id = 1
+name = "imu"
+driver = { type = "synthetic" }
+[stream.gpio]
+chip = "gpiochip0"
+data_ready_line = 3
+reconnect_min = 0.05
+reconnect_max = 1.5
+
+[[stream]]
+id = 2
+name = "scope"
+driver = { type = "synthetic" }
+gpio = { chip = "gpiochip0", output_line = 4 }
+)toml",
+                                      "gpio.toml");
+  ASSERT_EQ(c.streams.size(), 2u);
+  EXPECT_EQ(c.streams[0].gpio->reconnect_min, 0.05);
+  EXPECT_EQ(c.streams[0].gpio->reconnect_max, 1.5);
+  // Unset: the GPIO lines' default, 0.1 s doubling to 2 s.
+  EXPECT_EQ(c.streams[1].gpio->reconnect_min, 0.1);
+  EXPECT_EQ(c.streams[1].gpio->reconnect_max, 2.0);
+  try {
+    parse_config("[[stream]]\nid = 1\nname = \"a\"\ndriver = { type = \"synthetic\" }\n[stream.gpio]\nchip = \"gpiochip0\"\n"
+                 "output_line = 4\nreconnect_min = 0.5\nreconnect_max = 0.2\n",
+                 "cfg.toml");
+    FAIL() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "stream[1].gpio.reconnect_max");
+    EXPECT_EQ(e.line(), 9u);
+    EXPECT_EQ(e.message(), "must be >= reconnect_min (0.5 s), got 0.2");
+  }
+}
+
 TEST(Config, TheMostSpecificTableDecidesTheSmoothing) {
   testing::ScratchDir dir("posefair-config-");
   write_file(dir / "poses.csv", "t,qw,qx,qy,qz\n0,1,0,0,0\n");

@@ -191,8 +191,8 @@ TEST(GpioDataReady, ALineHeldByAnotherConsumerIsTakenOnceReleased) {
   o.chip = sim.chip_name();
   o.line.offset = 2;
   o.consumer = "posefair-test";
-  o.retry_min = 0.02;
-  o.retry_max = 0.1;
+  o.reconnect_min = 0.02;
+  o.reconnect_max = 0.1;
   o.log = logs.log();
   drivers::GpioDataReadySink sink(o, out);
 

@@ -169,6 +169,8 @@ struct GpioConfig {
   std::optional<drivers::GpioLineRef> output;      // output_line
   drivers::GpioOutputMode output_mode = drivers::GpioOutputMode::PerPose;
   double heartbeat_hz = 1.0;
+  double reconnect_min = 0.1;  // s: the backoff between requests of either line
+  double reconnect_max = 2.0;  // s, >= reconnect_min
 };
 
 struct StreamConfig {

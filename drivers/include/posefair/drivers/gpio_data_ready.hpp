@@ -12,9 +12,9 @@
 //
 // The line is requested lazily from push() (the driver's thread), so a missing chip, a line
 // held by another consumer (EBUSY) or a chip that goes away never stops the stream: samples
-// pass unpaired, the failure is logged once per reason, and the request is retried with
-// backoff (retry_min doubling to retry_max) on later pushes. Nothing here runs on the engine
-// or publisher threads.
+// pass unpaired, the failure is logged once per reason, and the request is retried with the
+// reconnect backoff (reconnect_backoff.hpp: reconnect_min doubling to reconnect_max) on later
+// pushes. Nothing here runs on the engine or publisher threads.
 #include <atomic>
 #include <cstdint>
 #include <mutex>
@@ -23,7 +23,8 @@
 
 #include "posefair/drivers/driver.hpp"
 #include "posefair/drivers/gpio_edge_pairing.hpp"
-#include "posefair/drivers/serial_driver.hpp"  // LogLevel, DriverLog
+#include "posefair/drivers/driver_log.hpp"
+#include "posefair/drivers/reconnect_backoff.hpp"
 
 struct gpiod_chip;
 struct gpiod_line;
@@ -55,20 +56,22 @@ class GpioLineHandle {
   void release();
   gpiod_line* line() const { return line_; }
   bool is_open() const { return line_ != nullptr; }
+  // After a request failed with EBUSY: " (held by '<consumer>')", for the log line.
+  std::string held_by() const;
 
  private:
   gpiod_chip* chip_ = nullptr;
   gpiod_line* line_ = nullptr;
 };
 
-struct GpioDataReadyOptions {
+// reconnect_min, reconnect_max: the backoff between requests of the line (ReconnectSettings;
+// the daemon's [stream.gpio] defaults are 0.1 s and 2 s).
+struct GpioDataReadyOptions : ReconnectSettings {
   std::string chip;
   GpioLineRef line;
   GpioEdge edge = GpioEdge::Rising;
   GpioBias bias = GpioBias::AsIs;
   EdgePairingOptions pairing;
-  double retry_min = 0.1;  // s: first wait after a failed request
-  double retry_max = 2.0;  // s: waits double up to this
   std::string consumer = "posefaird";
   DriverLog log;           // may be empty; called from the driver's thread
 };
@@ -110,7 +113,7 @@ class GpioDataReadySink final : public SampleSink {
   int fd_ = -1;
   bool clock_ok_ = true;
   double next_attempt_ = 0.0;
-  double delay_;
+  ReconnectBackoff backoff_;
   std::string logged_reason_;
   std::uint64_t attempts_ = 0;
 

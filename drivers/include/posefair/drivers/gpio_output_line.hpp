@@ -3,9 +3,10 @@
 // toggles once per published pose of its stream (on_pose(), called by the daemon's publisher
 // thread right after the pose was sent), or as a heartbeat at a fixed rate on its own thread.
 //
-// start() runs a small thread that requests the line (with backoff while the chip is missing
-// or the line busy) and, in heartbeat mode, toggles it. on_pose() is real-time safe: an atomic
-// load and, once the line is held, one ioctl (gpiod_line_set_value: no allocation, no lock).
+// start() runs a small thread that requests the line (with the reconnect backoff,
+// reconnect_backoff.hpp, while the chip is missing or the line busy) and, in heartbeat mode,
+// toggles it. on_pose() is real-time safe: an atomic load and, once the line is held, one
+// ioctl (gpiod_line_set_value: no allocation, no lock).
 #include <atomic>
 #include <cstdint>
 #include <string>
@@ -17,13 +18,13 @@ namespace posefair::drivers {
 
 enum class GpioOutputMode { PerPose, Heartbeat };
 
-struct GpioOutputOptions {
+// reconnect_min, reconnect_max: the backoff between requests of the line (ReconnectSettings;
+// the daemon's [stream.gpio] defaults are 0.1 s and 2 s).
+struct GpioOutputOptions : ReconnectSettings {
   std::string chip;
   GpioLineRef line;
   GpioOutputMode mode = GpioOutputMode::PerPose;
   double heartbeat_hz = 1.0;  // heartbeat mode: square wave of this frequency (two toggles per period)
-  double retry_min = 0.1;
-  double retry_max = 2.0;
   std::string consumer = "posefaird";
   DriverLog log;
 };

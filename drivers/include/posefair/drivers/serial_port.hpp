@@ -21,6 +21,8 @@
 #include <string_view>
 #include <vector>
 
+#include "posefair/drivers/usb_id.hpp"
+
 struct sp_port;  // libserialport's handle
 
 namespace posefair::drivers {
@@ -41,15 +43,6 @@ struct SerialSettings {
 void validate(const SerialSettings& settings);
 // "115200 8N1", "9600 7E2 rtscts".
 std::string describe(const SerialSettings& settings);
-
-struct UsbId {
-  std::uint16_t vid = 0;
-  std::uint16_t pid = 0;
-  friend bool operator==(const UsbId&, const UsbId&) = default;
-};
-// "1a86:7523" (hex, 1 to 4 digits each, either case) -> {0x1a86, 0x7523}; nullopt otherwise.
-std::optional<UsbId> parse_usb_id(std::string_view text);
-std::string to_string(const UsbId& id);  // "1a86:7523"
 
 // Which device to open: a path, or the first USB serial port (in path order) with this
 // VID:PID and, when given, this serial number.
