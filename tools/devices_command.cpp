@@ -6,7 +6,7 @@
 #include <iostream>
 #include <stdexcept>
 
-#include "exit_codes.hpp"
+#include "posefair/core/error.hpp"
 #include "posefair/drivers/decoder.hpp"
 
 namespace posefair::tools {
@@ -65,7 +65,7 @@ void add_devices_command(CLI::App& app, int& exit_code) {
       exit_code = kExitOk;
     } catch (const std::runtime_error& e) {
       std::cerr << "posefair devices: " << e.what() << "\n";
-      exit_code = kExitSoftware;
+      exit_code = posefair::exit_code(ErrorKind::Software);
     }
   });
 }
