@@ -604,10 +604,9 @@ class Parser {
       // An InvalidEngineSetting names the setting; it is reported at the key that set it.
       // Anything else (or a setting left at its default) at the innermost engine table.
       const auto* refused = dynamic_cast<const InvalidEngineSetting*>(&e);
-      const std::optional<EngineSetting> setting = refused ? std::optional(refused->setting()) : std::nullopt;
       const std::string what = e.what();
       Where at;
-      if (auto it = setting ? origin.find(*setting) : origin.end(); it != origin.end()) {
+      if (auto it = refused ? origin.find(refused->setting()) : origin.end(); it != origin.end()) {
         at = it->second;
       } else if (local != nullptr) {
         at = Where{local->table->source().begin, local->prefix};
@@ -617,7 +616,9 @@ class Parser {
         at = Where{stream_table.source().begin, stream_prefix};
       }
       std::string message = what;
-      const Smoothing* s = setting == EngineSetting::SmoothingR ? &r : setting == EngineSetting::SmoothingT ? &t : nullptr;
+      const Smoothing* s = nullptr;
+      if (refused && refused->setting() == EngineSetting::SmoothingR) s = &r;
+      if (refused && refused->setting() == EngineSetting::SmoothingT) s = &t;
       if (s != nullptr && s->from_cutoff)
         message = "cutoff_hz " + number(s->value) + " Hz at rate_hz " + number(rate->value) + " Hz gives " + what;
       if (!at.key.starts_with(stream_prefix)) message += " (for " + stream_prefix + " " + in_quotes(stream_name) + ")";

@@ -3,7 +3,6 @@
 #include "posefair/daemon/output_encoder.hpp"
 
 #include <algorithm>
-#include <array>
 
 namespace posefair::daemon {
 
@@ -11,7 +10,7 @@ const OutputEncoder& binary_output_encoder();      // wire_protocol.cpp: wire pr
 const OutputEncoder& json_lines_output_encoder();  // json_lines.cpp: JSON lines
 
 std::span<const OutputEncoder* const> output_encoders() {
-  static const std::array<const OutputEncoder*, 2> encoders = {
+  static const OutputEncoder* const encoders[] = {
       &binary_output_encoder(),
       &json_lines_output_encoder(),
   };
