@@ -1,7 +1,6 @@
 #pragma once
-// Which engine setting (WindowConfig or its GateConfig field) a check refused, as data: the
-// daemon's config loader maps it to the TOML key that set it, the CLI to its option, without
-// reading the message.
+// Which engine setting (a WindowConfig or GateConfig field) a check refused, as data: the
+// daemon's config loader maps it to the TOML key that set it without reading the message.
 #include <stdexcept>
 #include <string>
 
