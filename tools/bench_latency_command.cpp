@@ -12,7 +12,7 @@
 #include <thread>
 #include <vector>
 
-#include "exit_codes.hpp"
+#include "posefair/core/error.hpp"
 #include "posefair/daemon/config.hpp"
 #include "posefair/daemon/pipeline.hpp"
 #include "posefair/daemon/udp_socket.hpp"
@@ -83,7 +83,7 @@ int bench_latency(const LatencyOptions& o) {
     config = daemon::parse_config(toml, "bench-latency.toml");
   } catch (const daemon::ConfigError& e) {
     std::fprintf(stderr, "posefair bench latency: %s\n", e.what());
-    return kExitUsage;
+    return exit_code(ErrorKind::Usage);
   }
 
   std::atomic<bool> stop{false};

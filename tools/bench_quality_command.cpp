@@ -1,4 +1,4 @@
-#include "bench_quality_command.hpp"
+#include "bench_command.hpp"
 #include "bench_latency_command.hpp"
 
 #include <algorithm>
@@ -12,7 +12,7 @@
 #include <limits>
 #include <memory>
 
-#include "exit_codes.hpp"
+#include "posefair/core/error.hpp"
 #include "posefair/core/causal_fairing.hpp"
 #include "posefair/core/exponential_slerp_filter.hpp"
 #include "posefair/core/fairing_window.hpp"
@@ -210,7 +210,7 @@ int bench_quality(const std::string& data_dir, const std::string& out_dir, bool 
     sets = load_quality_datasets(data_dir, quick);
   } catch (const std::exception& e) {
     std::cerr << "posefair bench quality: " << e.what() << "\n";
-    return kExitNoInput;
+    return exit_code(ErrorKind::NoInput);
   }
   std::filesystem::create_directories(out_dir);
   std::vector<Result> results;

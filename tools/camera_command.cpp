@@ -13,7 +13,7 @@
 #include <optional>
 
 #include "camera_keyframe_file.hpp"
-#include "exit_codes.hpp"
+#include "posefair/core/error.hpp"
 #include "posefair/core/matrix_interpolation_study.hpp"
 
 namespace posefair::tools {
@@ -97,10 +97,10 @@ int run_interpolation(const CameraOptions& o) {
     keys = read_camera_keyframes(o.input);
   } catch (const std::ios_base::failure&) {
     std::cerr << "posefair camera: cannot open " << o.input << ": " << std::strerror(errno) << "\n";
-    return kExitNoInput;
+    return exit_code(ErrorKind::NoInput);
   } catch (const KeyframeFileError& e) {
     std::cerr << "posefair camera: " << e.what() << "\n";
-    return kExitDataErr;
+    return exit_code(ErrorKind::DataErr);
   }
   std::vector<double> key_times;
   std::vector<CameraKey> camera_keys;
@@ -119,14 +119,14 @@ int run_interpolation(const CameraOptions& o) {
     if (e.key >= 0 && e.origin_key >= 0 && e.origin_key != e.key)
       std::cerr << "keyframe relative to the keyframe at line " << keys[e.origin_key].line << ": ";
     std::cerr << e.message << "\n";
-    return kExitDataErr;
+    return exit_code(ErrorKind::DataErr);
   }
   std::ofstream file;
   if (!o.output.empty()) {
     file.open(o.output);
     if (!file) {
       std::cerr << "posefair camera: cannot create " << o.output << ": " << std::strerror(errno) << "\n";
-      return kExitCantCreate;
+      return exit_code(ErrorKind::CantCreate);
     }
   }
   std::ostream& out = o.output.empty() ? std::cout : file;
@@ -137,7 +137,7 @@ int run_interpolation(const CameraOptions& o) {
   out.flush();
   if (!out) {
     std::cerr << "posefair camera: writing " << (o.output.empty() ? "stdout" : o.output) << " failed\n";
-    return kExitCantCreate;
+    return exit_code(ErrorKind::CantCreate);
   }
   return kExitOk;
 }
@@ -154,7 +154,7 @@ int run_study(const CameraOptions& o) {
   };
   std::ofstream sq, lg, pl;
   if (!open("sqrt_iterations.csv", sq) || !open("log_square_roots.csv", lg) || !open("path_length.csv", pl))
-    return kExitCantCreate;
+    return exit_code(ErrorKind::CantCreate);
   const int n = o.study_matrices;
   sq << "matrix,iteration,residual,principal\n";
   for (const auto& r : sqrt_iteration_study(n, 12, 42))
@@ -180,7 +180,7 @@ int run_study(const CameraOptions& o) {
               p.pairs.size(), p.rejected_unsafe, p.vertices_skipped, p.mean_parameter, p.median_parameter,
               p.mean_matrix, p.median_matrix);
   std::printf("wrote    %s/{sqrt_iterations,log_square_roots,path_length}.csv\n", o.study_dir.c_str());
-  return (sq && lg && pl) ? kExitOk : kExitCantCreate;
+  return (sq && lg && pl) ? kExitOk : exit_code(ErrorKind::CantCreate);
 }
 
 }  // namespace
@@ -224,7 +224,7 @@ void add_camera_command(CLI::App& app, int& exit_code) {
     }
     if (o->input.empty()) {
       std::cerr << "posefair camera: a keyframe file is required\n" << cmd->help();
-      exit_code = kExitUsage;
+      exit_code = posefair::exit_code(ErrorKind::Usage);
       return;
     }
     exit_code = run_interpolation(*o);

@@ -8,7 +8,7 @@
 #include <string_view>
 #include <stdexcept>
 
-#include "exit_codes.hpp"
+#include "posefair/core/error.hpp"
 #include "posefair/drivers/can_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
 #include "posefair/drivers/hid_report_decoder.hpp"
@@ -91,7 +91,7 @@ void add_devices_command(CLI::App& app, int& exit_code) {
       exit_code = kExitOk;
     } catch (const std::runtime_error& e) {
       std::cerr << "posefair devices: " << e.what() << "\n";
-      exit_code = kExitSoftware;
+      exit_code = posefair::exit_code(ErrorKind::Software);
     }
   });
 }

@@ -16,7 +16,7 @@
 #include <optional>
 #include <stdexcept>
 
-#include "exit_codes.hpp"
+#include "posefair/core/error.hpp"
 #include "posefair/core/causal_fairing.hpp"
 #include "posefair/core/fairing.hpp"
 #include "posefair/core/quality_metrics.hpp"
@@ -48,7 +48,7 @@ int write_output(const FairOptions& o, const formats::PoseFile& file, const Pose
     formats::write_pose_file(o.output, file, poses);
   } catch (const formats::PoseFileError& e) {
     std::cerr << "posefair fair: " << e.what() << "\n";
-    return kExitCantCreate;
+    return exit_code(ErrorKind::CantCreate);
   }
   return kExitOk;
 }
@@ -85,14 +85,14 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
       c.smoothing_r = c.smoothing_t = smoothing_for_cutoff(*o.cutoff_hz, rate, c.order);
     } catch (const std::invalid_argument& e) {
       std::cerr << "posefair fair: --cutoff " << *o.cutoff_hz << " Hz at the file's " << rate << " Hz: " << e.what() << "\n";
-      return kExitUsage;
+      return exit_code(ErrorKind::Usage);
     }
   }
   try {
     validate(c);
   } catch (const std::invalid_argument& e) {
     std::cerr << "posefair fair: " << e.what() << "\n";
-    return kExitUsage;
+    return exit_code(ErrorKind::Usage);
   }
   const auto t0 = std::chrono::steady_clock::now();
   const CausalResult r = fair_causal(in, c);
@@ -120,7 +120,7 @@ int run_fair(FairOptions o) {
     std::ifstream probe(o.input);
     if (!probe) {
       std::cerr << "posefair fair: cannot open " << o.input << ": " << std::strerror(errno) << "\n";
-      return kExitNoInput;
+      return exit_code(ErrorKind::NoInput);
     }
   }
   formats::ReadOptions ro;
@@ -135,7 +135,7 @@ int run_fair(FairOptions o) {
     read.emplace(formats::read_pose_file(o.input, ro));
   } catch (const formats::PoseFileError& e) {
     std::cerr << "posefair fair: " << e.what() << "\n";
-    return kExitDataErr;
+    return exit_code(ErrorKind::DataErr);
   }
   const formats::PoseFile& file = *read;
   for (const std::string& w : file.warnings()) std::cerr << "posefair fair: warning: " << w << "\n";
@@ -165,7 +165,7 @@ int run_fair(FairOptions o) {
   } catch (const std::invalid_argument& e) {
     // Too few samples for the order (the parameters were checked by the command line).
     std::cerr << "posefair fair: " << o.input << ": " << e.what() << "\n";
-    return kExitDataErr;
+    return exit_code(ErrorKind::DataErr);
   }
 }
 

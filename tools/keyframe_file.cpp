@@ -8,6 +8,7 @@
 #include <sstream>
 #include <vector>
 
+#include "posefair/core/error.hpp"
 #include "posefair/formats/pose_file.hpp"
 
 namespace posefair::tools {
@@ -92,7 +93,9 @@ SplineKeyframes parse_keyframes(std::istream& in, const std::string& name) {
 
 SplineKeyframes read_keyframes(const std::filesystem::path& path) {
   std::ifstream in(path);
-  if (!in) throw PoseFileError(path.string(), 0, std::string("cannot open: ") + std::strerror(errno));
+  // An unreadable file is NoInput, not a malformed one: the message as PoseFileError words it.
+  if (!in)
+    throw Error(ErrorKind::NoInput, PoseFileError(path.string(), 0, std::string("cannot open: ") + std::strerror(errno)).what());
   return parse_keyframes(in, path.string());
 }
 

@@ -9,7 +9,8 @@
 //
 // Every keyframe line of one file has the same layout. Times must increase strictly,
 // quaternions must have | |q| − 1 | <= 1e-3 (they are renormalised), and there must be at least
-// two keyframes. Any problem is a formats::PoseFileError "<path>:<line>: <message>".
+// two keyframes. Any problem is a formats::PoseFileError "<path>:<line>: <message>"; a file
+// that cannot be opened is an Error of kind NoInput (worded the same way).
 #include <filesystem>
 #include <iosfwd>
 #include <string>

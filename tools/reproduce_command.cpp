@@ -5,7 +5,7 @@
 #include <fstream>
 #include <iostream>
 
-#include "exit_codes.hpp"
+#include "posefair/core/error.hpp"
 #include "posefair/core/fairing_study.hpp"
 
 namespace posefair::tools {
@@ -31,7 +31,7 @@ int reproduce_lee_shin(const std::filesystem::path& out, int iterations, int see
   std::ofstream f(out);
   if (!f) {
     std::cerr << "posefair reproduce: cannot write " << out << "\n";
-    return kExitCantCreate;
+    return exit_code(ErrorKind::CantCreate);
   }
   f << "run,order,lambda_r,variant,iteration,mean_error_to_input,mean_error_to_truth,max_error_to_input,"
        "mean_angular_acceleration,mean_position_error_to_truth,mean_acceleration,rotational_energy\n";
@@ -57,7 +57,7 @@ int reproduce_lee_shin(const std::filesystem::path& out, int iterations, int see
   f.close();
   if (!f) {
     std::cerr << "posefair reproduce: writing " << out << " failed\n";
-    return kExitCantCreate;
+    return exit_code(ErrorKind::CantCreate);
   }
   std::printf("wrote %s\n", out.c_str());
   return kExitOk;

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "exit_codes.hpp"
+#include "posefair/core/error.hpp"
 #include "posefair/core/pose_spline.hpp"
 #include "posefair/formats/pose_file.hpp"
 
@@ -55,12 +55,6 @@ void apply_names(ResampleOptions& o) {
                                                : gs::KnotVelocityEstimator::Bessel;
 }
 
-// A failure with its exit status; the message is printed after "posefair resample: ".
-struct CommandError {
-  int exit_code;
-  std::string message;
-};
-
 // The 1-based line of the n-th data row (0-based) of a TUM or CSV file, 0 when unknown.
 std::size_t data_line(const std::string& path, formats::PoseFormat format, std::size_t n) {
   std::ifstream in(path);
@@ -85,7 +79,7 @@ std::size_t data_line(const std::string& path, formats::PoseFormat format, std::
 void check_increasing(const ResampleOptions& o, const formats::PoseFile& file) {
   const auto& t = file.poses().time;
   if (t.size() < 2)
-    throw CommandError{kExitDataErr, o.input + ": " + std::to_string(t.size()) +
+    throw Error{ErrorKind::DataErr, o.input + ": " + std::to_string(t.size()) +
                                          " sample(s); a spline needs at least 2"};
   for (std::size_t i = 1; i < t.size(); ++i) {
     if (t[i] > t[i - 1]) continue;
@@ -94,13 +88,13 @@ void check_increasing(const ResampleOptions& o, const formats::PoseFile& file) {
     m.precision(17);
     m << o.input << ":" << (line ? std::to_string(line) : "sample " + std::to_string(i)) << ": time " << t[i]
       << " does not increase on the previous sample's " << t[i - 1] << " (the spline needs strictly increasing times)";
-    throw CommandError{kExitDataErr, m.str()};
+    throw Error{ErrorKind::DataErr, m.str()};
   }
 }
 
 std::vector<double> read_times(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw CommandError{kExitNoInput, "cannot open " + path + ": " + std::strerror(errno)};
+  if (!in) throw Error{ErrorKind::NoInput, "cannot open " + path + ": " + std::strerror(errno)};
   std::vector<double> times;
   std::string line;
   for (std::size_t number = 1; std::getline(in, line); ++number) {
@@ -116,16 +110,16 @@ std::vector<double> read_times(const std::string& path) {
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used != field.size() || !std::isfinite(t)) throw CommandError{kExitDataErr, where + "'" + field + "' is not a time"};
+    if (used != field.size() || !std::isfinite(t)) throw Error{ErrorKind::DataErr, where + "'" + field + "' is not a time"};
     if (!times.empty() && !(t > times.back())) {
       std::ostringstream m;
       m.precision(17);
       m << where << "time " << t << " does not increase on the previous " << times.back();
-      throw CommandError{kExitDataErr, m.str()};
+      throw Error{ErrorKind::DataErr, m.str()};
     }
     times.push_back(t);
   }
-  if (times.empty()) throw CommandError{kExitDataErr, path + ": no times"};
+  if (times.empty()) throw Error{ErrorKind::DataErr, path + ": no times"};
   return times;
 }
 
@@ -140,7 +134,7 @@ std::vector<double> rate_times(double start, double end, double rate) {
 
 void write_derivatives(const std::string& path, const gs::PoseSpline& spline, const std::vector<double>& times) {
   std::ofstream out(path);
-  if (!out) throw CommandError{kExitCantCreate, "cannot create " + path + ": " + std::strerror(errno)};
+  if (!out) throw Error{ErrorKind::CantCreate, "cannot create " + path + ": " + std::strerror(errno)};
   out << "t,wx,wy,wz,w_norm,ax,ay,az,a_norm\n";
   out.precision(17);
   for (double t : times) {
@@ -152,7 +146,7 @@ void write_derivatives(const std::string& path, const gs::PoseSpline& spline, co
     out << t << ',' << w.x() << ',' << w.y() << ',' << w.z() << ',' << w.norm() << ',' << a.x() << ',' << a.y() << ','
         << a.z() << ',' << a.norm() << '\n';
   }
-  if (!out.flush()) throw CommandError{kExitCantCreate, "cannot write " + path};
+  if (!out.flush()) throw Error{ErrorKind::CantCreate, "cannot write " + path};
 }
 
 std::string describe(const gs::PoseSplineOptions& s) {
@@ -175,7 +169,7 @@ void run_holdout(const ResampleOptions& o, const PoseSequence& in) {
     if (in.has_position()) knots.position.push_back(in.position[i]);
   }
   if (knots.size() < 2)
-    throw CommandError{kExitDataErr, o.input + ": --holdout " + std::to_string(n) + " leaves fewer than 2 knots"};
+    throw Error{ErrorKind::DataErr, o.input + ": --holdout " + std::to_string(n) + " leaves fewer than 2 knots"};
   const gs::PoseSpline spline(knots, o.spline);
   double rot2 = 0, rot_max = 0, pos2 = 0, pos_max = 0, geo_rot2 = 0, geo_rot_max = 0, geo_pos2 = 0, geo_pos_max = 0;
   std::size_t count = 0;
@@ -196,7 +190,7 @@ void run_holdout(const ResampleOptions& o, const PoseSequence& in) {
     }
     ++count;
   }
-  if (count == 0) throw CommandError{kExitDataErr, o.input + ": no held-out samples inside the knots' range"};
+  if (count == 0) throw Error{ErrorKind::DataErr, o.input + ": no held-out samples inside the knots' range"};
   const double deg = 180.0 / std::numbers::pi;
   std::printf("holdout  every %zu-th sample as a knot: %zu knots, %zu held-out samples, %s\n", n, knots.size(), count,
               describe(o.spline).c_str());
@@ -209,16 +203,16 @@ void run_holdout(const ResampleOptions& o, const PoseSequence& in) {
 
 int run_resample(const ResampleOptions& o) {
   const int modes = (o.rate ? 1 : 0) + (o.times_file.empty() ? 0 : 1) + (o.holdout ? 1 : 0);
-  if (modes != 1) throw CommandError{kExitUsage, "give exactly one of --rate, --times or --holdout"};
-  if (!o.holdout && o.output.empty()) throw CommandError{kExitUsage, "--output is required with --rate or --times"};
+  if (modes != 1) throw Error{ErrorKind::Usage, "give exactly one of --rate, --times or --holdout"};
+  if (!o.holdout && o.output.empty()) throw Error{ErrorKind::Usage, "--output is required with --rate or --times"};
   try {
     gs::validate(o.spline);
   } catch (const std::invalid_argument& e) {
-    throw CommandError{kExitUsage, e.what()};
+    throw Error{ErrorKind::Usage, e.what()};
   }
   {
     std::ifstream probe(o.input);
-    if (!probe) throw CommandError{kExitNoInput, "cannot open " + o.input + ": " + std::strerror(errno)};
+    if (!probe) throw Error{ErrorKind::NoInput, "cannot open " + o.input + ": " + std::strerror(errno)};
   }
   formats::ReadOptions ro;
   ro.format = o.format;
@@ -227,10 +221,10 @@ int run_resample(const ResampleOptions& o) {
   try {
     read.emplace(formats::read_pose_file(o.input, ro));
   } catch (const formats::PoseFileError& e) {
-    throw CommandError{kExitDataErr, e.what()};
+    throw Error{ErrorKind::DataErr, e.what()};
   }
   if (read->format() == formats::PoseFormat::Bvh)
-    throw CommandError{kExitUsage, o.input + ": resample reads TUM or CSV files"};
+    throw Error{ErrorKind::Usage, o.input + ": resample reads TUM or CSV files"};
   for (const std::string& w : read->warnings()) std::cerr << "posefair resample: warning: " << w << "\n";
   check_increasing(o, *read);
   const PoseSequence& in = read->poses();
@@ -248,7 +242,7 @@ int run_resample(const ResampleOptions& o) {
       m << o.times_file << ":" << data_line(o.times_file, formats::PoseFormat::Tum, i) << ": time " << times[i]
         << " is outside the data's range [" << in.time.front() << ", " << in.time.back() << "] of " << o.input
         << " (--clamp holds the end poses)";
-      throw CommandError{kExitDataErr, m.str()};
+      throw Error{ErrorKind::DataErr, m.str()};
     }
   }
   const gs::PoseSpline spline(in, o.spline);
@@ -269,7 +263,7 @@ int run_resample(const ResampleOptions& o) {
   try {
     formats::write_pose_file(o.output, document, out);
   } catch (const formats::PoseFileError& e) {
-    throw CommandError{kExitCantCreate, e.what()};
+    throw Error{ErrorKind::CantCreate, e.what()};
   }
   if (!o.derivatives.empty()) write_derivatives(o.derivatives, spline, times);
   if (!o.quiet) {
@@ -321,9 +315,9 @@ void add_resample_command(CLI::App& app, int& exit_code) {
     try {
       apply_names(*o);
       exit_code = run_resample(*o);
-    } catch (const CommandError& e) {
-      std::cerr << "posefair resample: " << e.message << "\n";
-      exit_code = e.exit_code;
+    } catch (const Error& e) {  // the message is printed after "posefair resample: "
+      std::cerr << "posefair resample: " << e.what() << "\n";
+      exit_code = e.exit_code();
     }
   });
 }

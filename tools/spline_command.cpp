@@ -9,7 +9,7 @@
 #include <optional>
 #include <string>
 
-#include "exit_codes.hpp"
+#include "posefair/core/error.hpp"
 #include "keyframe_file.hpp"
 #include "posefair/core/covariant_acceleration.hpp"
 #include "posefair/core/quaternion_spline.hpp"
@@ -72,9 +72,12 @@ int run_spline(SplineCommandOptions o) {
   SplineKeyframes keys;
   try {
     keys = read_keyframes(o.input);
+  } catch (const Error& e) {  // the file cannot be opened
+    std::cerr << "posefair spline: " << e.what() << "\n";
+    return e.exit_code();
   } catch (const formats::PoseFileError& e) {
     std::cerr << "posefair spline: " << e.what() << "\n";
-    return e.line() == 0 && keys.time.empty() && e.message().rfind("cannot open", 0) == 0 ? kExitNoInput : kExitDataErr;
+    return exit_code(ErrorKind::DataErr);
   }
   const std::size_t candidate_frames = (keys.time.size() - 1) * static_cast<std::size_t>(o.spline.segments_per_interval - 1);
   o.spline.variable_frames = o.frames ? *o.frames : o.accuracy ? static_cast<int>(candidate_frames) : 4;
@@ -101,15 +104,15 @@ int run_spline(SplineCommandOptions o) {
     formats::write_pose_file(o.output, doc, poses);
   } catch (const formats::PoseFileError& e) {
     std::cerr << "posefair spline: " << e.what() << "\n";
-    return kExitCantCreate;
+    return exit_code(ErrorKind::CantCreate);
   }
   if (!o.stages_csv.empty() && !write_text(o.stages_csv, stages_table(r))) {
     std::cerr << "posefair spline: cannot write " << o.stages_csv << "\n";
-    return kExitCantCreate;
+    return exit_code(ErrorKind::CantCreate);
   }
   if (!o.trace_csv.empty() && !write_text(o.trace_csv, trace_table(r, times, o.spline.alpha))) {
     std::cerr << "posefair spline: cannot write " << o.trace_csv << "\n";
-    return kExitCantCreate;
+    return exit_code(ErrorKind::CantCreate);
   }
 
   std::fprintf(stderr, "keys      %s: %zu keyframes over %.6g s, end angular velocities %s/%s\n", o.input.c_str(),

@@ -14,14 +14,11 @@
 #include <optional>
 #include <system_error>
 
-#include "exit_codes.hpp"
+#include "posefair/core/error.hpp"
 #include "posefair/daemon/json_lines.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 
 namespace posefair::tools {
-
-// EX_UNAVAILABLE from sysexits.h: the port cannot be bound or the group not joined.
-inline constexpr int kExitUnavailable = 69;
 
 // ---------------------------------------------------------------------------------------------
 // SequenceTracker
@@ -237,7 +234,7 @@ int run_sub(const SubOptions& o) {
     group = daemon::Endpoint::parse_address(o.group);
     if (!group || !group->is_multicast()) {
       std::cerr << "posefair sub: --group " << o.group << " is not a multicast address\n";
-      return kExitUsage;
+      return exit_code(ErrorKind::Usage);
     }
   }
   std::string listen_text = o.listen;
@@ -245,16 +242,16 @@ int run_sub(const SubOptions& o) {
   const auto listen = daemon::Endpoint::parse(listen_text, daemon::kDefaultPort);
   if (!listen) {
     std::cerr << "posefair sub: --listen " << listen_text << " is not ADDR:PORT or [IPV6]:PORT\n";
-    return kExitUsage;
+    return exit_code(ErrorKind::Usage);
   }
   if (group && group->family() != listen->family()) {
     std::cerr << "posefair sub: --group " << o.group << " and --listen " << listen_text
               << " are of different address families\n";
-    return kExitUsage;
+    return exit_code(ErrorKind::Usage);
   }
   if (!o.interface.empty() && !group) {
     std::cerr << "posefair sub: --interface needs --group\n";
-    return kExitUsage;
+    return exit_code(ErrorKind::Usage);
   }
 
   daemon::UdpSocket socket;
@@ -266,7 +263,7 @@ int run_sub(const SubOptions& o) {
     socket = daemon::UdpSocket::bind(*listen, ro);
   } catch (const std::system_error& e) {
     std::cerr << "posefair sub: " << e.what() << "\n";
-    return kExitUnavailable;
+    return exit_code(ErrorKind::Unavailable);  // the port cannot be bound or the group not joined
   }
   std::cerr << "posefair sub: listening on " << socket.local_endpoint().to_string();
   if (group) std::cerr << ", group " << group->address_string() << (o.interface.empty() ? "" : " on " + o.interface);

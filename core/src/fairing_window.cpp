@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "posefair/core/engine_setting.hpp"
+
 namespace posefair {
 namespace {
 
@@ -63,28 +65,32 @@ void difference_adjoint(std::span<Vec3> v, int len) {
 }  // namespace
 
 void validate(const WindowConfig& c) {
-  auto bad = [](const std::string& what) { throw std::invalid_argument(what); };
-  if (c.order != 2 && c.order != 3) bad("order must be 2 or 3, got " + std::to_string(c.order));
+  using S = EngineSetting;
+  auto bad = [](EngineSetting setting, const std::string& what) { throw InvalidEngineSetting(setting, what); };
+  if (c.order != 2 && c.order != 3) bad(S::Order, "order must be 2 or 3, got " + std::to_string(c.order));
   if (c.window < c.order + 1 || c.window > 4096)
-    bad("window must hold " + std::to_string(c.order + 1) + " to 4096 samples for order " +
-        std::to_string(c.order) + ", got " + std::to_string(c.window));
+    bad(S::Window, "window must hold " + std::to_string(c.order + 1) + " to 4096 samples for order " +
+                       std::to_string(c.order) + ", got " + std::to_string(c.window));
   if (c.lag < 0 || c.lag >= c.window)
-    bad("lag must be in [0, window-1] = [0, " + std::to_string(c.window - 1) + "], got " + std::to_string(c.lag));
-  if (c.iterations < 0 || c.iterations > 1000) bad("iterations must be in [0, 1000], got " + std::to_string(c.iterations));
+    bad(S::Lag, "lag must be in [0, window-1] = [0, " + std::to_string(c.window - 1) + "], got " + std::to_string(c.lag));
+  if (c.iterations < 0 || c.iterations > 1000)
+    bad(S::Iterations, "iterations must be in [0, 1000], got " + std::to_string(c.iterations));
   if (c.iterations == 0 && c.solver == WindowSolver::GaussNewton)
-    bad("iterations must be at least 1 for the gauss-newton solver (0 would emit the warm-start extrapolation)");
+    bad(S::Iterations, "iterations must be at least 1 for the gauss-newton solver (0 would emit the warm-start extrapolation)");
   // Beyond about 1e10 the window is already an exact polynomial fit and the system only loses
   // precision (I + μDᵀD becomes numerically singular).
-  if (!(c.smoothing_r >= 0.0 && c.smoothing_r <= kMaxSmoothing)) bad("smoothing_r must be in [0, 1e10], got " + std::to_string(c.smoothing_r));
-  if (!(c.smoothing_t >= 0.0 && c.smoothing_t <= kMaxSmoothing)) bad("smoothing_t must be in [0, 1e10], got " + std::to_string(c.smoothing_t));
-  if (!(c.continuity >= 0.0) || !std::isfinite(c.continuity)) bad("continuity must be finite and >= 0");
-  if (!(c.lambda_r > 0.0 && c.lambda_r <= 1.0)) bad("lambda_r must be in (0, 1]");
-  if (!(c.lambda_t > 0.0 && c.lambda_t <= 1.0)) bad("lambda_t must be in (0, 1]");
-  if (!(c.epsilon_r > 0.0)) bad("epsilon_r must be positive");
-  if (!(c.epsilon_t > 0.0)) bad("epsilon_t must be positive");
-  if (c.continuity > 0.0 && c.window > 512) bad("continuity needs a window of at most 512 samples");
+  if (!(c.smoothing_r >= 0.0 && c.smoothing_r <= kMaxSmoothing))
+    bad(S::SmoothingR, "smoothing_r must be in [0, 1e10], got " + std::to_string(c.smoothing_r));
+  if (!(c.smoothing_t >= 0.0 && c.smoothing_t <= kMaxSmoothing))
+    bad(S::SmoothingT, "smoothing_t must be in [0, 1e10], got " + std::to_string(c.smoothing_t));
+  if (!(c.continuity >= 0.0) || !std::isfinite(c.continuity)) bad(S::Continuity, "continuity must be finite and >= 0");
+  if (!(c.lambda_r > 0.0 && c.lambda_r <= 1.0)) bad(S::LambdaR, "lambda_r must be in (0, 1]");
+  if (!(c.lambda_t > 0.0 && c.lambda_t <= 1.0)) bad(S::LambdaT, "lambda_t must be in (0, 1]");
+  if (!(c.epsilon_r > 0.0)) bad(S::EpsilonR, "epsilon_r must be positive");
+  if (!(c.epsilon_t > 0.0)) bad(S::EpsilonT, "epsilon_t must be positive");
+  if (c.continuity > 0.0 && c.window > 512) bad(S::Continuity, "continuity needs a window of at most 512 samples");
   if (c.bound == BoundPolicy::Window && c.solver == WindowSolver::Linear)
-    bad("the window bound policy needs an iterative solver (gauss-newton or sweeps); linear solves in closed form");
+    bad(S::Bound, "the window bound policy needs an iterative solver (gauss-newton or sweeps); linear solves in closed form");
 }
 
 double smoothing_for_cutoff(double cutoff_hz, double rate_hz, int order) {
@@ -144,10 +150,10 @@ void FairingWindow::check_continuity_stability() const {
   for (int j = 1; j < taps; ++j) companion(j, j - 1) = 1.0;
   const double radius = companion.eigenvalues().cwiseAbs().maxCoeff();
   if (!(radius < 1.0 - 1e-9))
-    throw std::invalid_argument("continuity " + std::to_string(config_.continuity) + " with smoothing " +
-                                std::to_string(config_.smoothing_r) + ", window " + std::to_string(w) + " and lag " +
-                                std::to_string(lag) + " makes the output recursion unstable (spectral radius " +
-                                std::to_string(radius) + "); lower the continuity or the smoothing");
+    throw InvalidEngineSetting(EngineSetting::Continuity, "continuity " + std::to_string(config_.continuity) + " with smoothing " +
+        std::to_string(config_.smoothing_r) + ", window " + std::to_string(w) + " and lag " +
+        std::to_string(lag) + " makes the output recursion unstable (spectral radius " +
+        std::to_string(radius) + "); lower the continuity or the smoothing");
 }
 
 void FairingWindow::precompute_linear_rows() {

@@ -3,12 +3,15 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "posefair/core/engine_setting.hpp"
+
 namespace posefair {
 
 SampleGate::SampleGate(const GateConfig& config) : config_(config) {
   if (!(config.unit_tolerance >= 0.0 && config.unit_tolerance < 1.0))
-    throw std::invalid_argument("unit_tolerance must be in [0, 1)");
-  if (!(config.gap_threshold > 0.0)) throw std::invalid_argument("gap_threshold must be positive");
+    throw InvalidEngineSetting(EngineSetting::UnitTolerance, "unit_tolerance must be in [0, 1)");
+  if (!(config.gap_threshold > 0.0))
+    throw InvalidEngineSetting(EngineSetting::GapThreshold, "gap_threshold must be positive");
 }
 
 GateVerdict SampleGate::check(Sample& s) {

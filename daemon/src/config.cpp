@@ -19,7 +19,9 @@
 #include <string_view>
 #include <utility>
 
+#include "posefair/core/engine_setting.hpp"
 #include "posefair/core/sample_gate.hpp"
+#include "posefair/daemon/output_encoder.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
 #include "posefair/drivers/can_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
@@ -46,11 +48,10 @@ std::string format_what(const std::string& file, std::uint32_t line, std::uint32
 
 ConfigError::ConfigError(std::string file, std::uint32_t line, std::uint32_t column, std::string key,
                          std::string message)
-    : std::runtime_error(format_what(file, line, column, key, message)),
+    : Error(ErrorKind::Config, format_what(file, line, column, key, message), key),
       file_(std::move(file)),
       line_(line),
       column_(column),
-      key_(std::move(key)),
       message_(std::move(message)) {}
 
 namespace {
@@ -430,6 +431,11 @@ class Parser {
 
   template <typename E>
   E get_choice(const toml::node& n, const std::string& key, std::initializer_list<Choice<E>> choices) const {
+    return get_choice<E>(n, key, std::span<const Choice<E>>(choices.begin(), choices.size()));
+  }
+
+  template <typename E>
+  E get_choice(const toml::node& n, const std::string& key, std::span<const Choice<E>> choices) const {
     const std::string s = get_string(n, key);
     std::vector<std::string_view> texts;
     for (const Choice<E>& c : choices) {
@@ -555,7 +561,7 @@ class Parser {
                             const std::optional<Given<double>>& driver_rate, const toml::table& stream_table,
                             const std::string& stream_prefix, const std::string& stream_name) const {
     WindowConfig c;
-    std::map<std::string, Where, std::less<>> origin;  // WindowConfig field -> where it was set
+    std::map<EngineSetting, Where> origin;  // WindowConfig field -> where it was set
     struct Smoothing {
       bool set = false;
       bool from_cutoff = false;
@@ -565,29 +571,29 @@ class Parser {
     Smoothing r, t;
     for (const EngineLayer* layer : {&global, local}) {
       if (layer == nullptr) continue;
-      auto take = [&](const auto& given, auto& field, const char* name) {
+      auto take = [&](const auto& given, auto& field, EngineSetting setting) {
         if (given) {
           field = given->value;
-          origin[name] = given->where;
+          origin[setting] = given->where;
         }
       };
-      take(layer->window, c.window, "window");
-      take(layer->lag, c.lag, "lag");
-      take(layer->order, c.order, "order");
-      take(layer->solver, c.solver, "solver");
-      take(layer->iterations, c.iterations, "iterations");
-      take(layer->continuity, c.continuity, "continuity");
-      take(layer->lambda_r, c.lambda_r, "lambda_r");
-      take(layer->lambda_t, c.lambda_t, "lambda_t");
-      take(layer->variant, c.variant, "variant");
-      take(layer->epsilon_t, c.epsilon_t, "epsilon_t");
-      take(layer->bound, c.bound, "bound");
-      take(layer->gap, c.gate.gap_threshold, "gap_threshold");
-      take(layer->unit_tolerance, c.gate.unit_tolerance, "unit_tolerance");
+      take(layer->window, c.window, EngineSetting::Window);
+      take(layer->lag, c.lag, EngineSetting::Lag);
+      take(layer->order, c.order, EngineSetting::Order);
+      take(layer->solver, c.solver, EngineSetting::Solver);
+      take(layer->iterations, c.iterations, EngineSetting::Iterations);
+      take(layer->continuity, c.continuity, EngineSetting::Continuity);
+      take(layer->lambda_r, c.lambda_r, EngineSetting::LambdaR);
+      take(layer->lambda_t, c.lambda_t, EngineSetting::LambdaT);
+      take(layer->variant, c.variant, EngineSetting::Variant);
+      take(layer->epsilon_t, c.epsilon_t, EngineSetting::EpsilonT);
+      take(layer->bound, c.bound, EngineSetting::Bound);
+      take(layer->gap, c.gate.gap_threshold, EngineSetting::GapThreshold);
+      take(layer->unit_tolerance, c.gate.unit_tolerance, EngineSetting::UnitTolerance);
       if (layer->epsilon_r) {
         // Given as a rotation angle; the engine's bound is the distance on S³, half of it.
         c.epsilon_r = layer->epsilon_r->value / 2.0;
-        origin["epsilon_r"] = layer->epsilon_r->where;
+        origin[EngineSetting::EpsilonR] = layer->epsilon_r->where;
       }
       // A more specific table replaces what a less specific one said, key by key; cutoff_hz
       // counts as `smoothing` given as a frequency.
@@ -606,9 +612,9 @@ class Parser {
     else if (global.rate_hz)
       rate = global.rate_hz;
 
-    auto resolve_smoothing = [&](const Smoothing& s, double& field, const char* name) {
+    auto resolve_smoothing = [&](const Smoothing& s, double& field, EngineSetting setting) {
       if (!s.set) return;
-      origin[name] = s.where;
+      origin[setting] = s.where;
       if (!s.from_cutoff) {
         field = s.value;
         return;
@@ -623,8 +629,8 @@ class Parser {
                           number(rate->value) + " Hz (" + rate->where.key + ")");
       }
     };
-    resolve_smoothing(r, c.smoothing_r, "smoothing_r");
-    resolve_smoothing(t, c.smoothing_t, "smoothing_t");
+    resolve_smoothing(r, c.smoothing_r, EngineSetting::SmoothingR);
+    resolve_smoothing(t, c.smoothing_t, EngineSetting::SmoothingT);
 
     try {
       validate(c);
@@ -638,11 +644,12 @@ class Parser {
         const SampleGate gate(c.gate);
       }
     } catch (const std::invalid_argument& e) {
+      // An InvalidEngineSetting names the setting; it is reported at the key that set it.
+      // Anything else (or a setting left at its default) at the innermost engine table.
+      const auto* refused = dynamic_cast<const InvalidEngineSetting*>(&e);
       const std::string what = e.what();
-      std::string field = what.substr(0, what.find(' '));
-      if (what.starts_with("the window bound policy")) field = "bound";
       Where at;
-      if (auto it = origin.find(field); it != origin.end()) {
+      if (auto it = refused ? origin.find(refused->setting()) : origin.end(); it != origin.end()) {
         at = it->second;
       } else if (local != nullptr) {
         at = Where{local->table->source().begin, local->prefix};
@@ -652,7 +659,9 @@ class Parser {
         at = Where{stream_table.source().begin, stream_prefix};
       }
       std::string message = what;
-      const Smoothing* s = field == "smoothing_r" ? &r : field == "smoothing_t" ? &t : nullptr;
+      const Smoothing* s = nullptr;
+      if (refused && refused->setting() == EngineSetting::SmoothingR) s = &r;
+      if (refused && refused->setting() == EngineSetting::SmoothingT) s = &t;
       if (s != nullptr && s->from_cutoff)
         message = "cutoff_hz " + number(s->value) + " Hz at rate_hz " + number(rate->value) + " Hz gives " + what;
       if (!at.key.starts_with(stream_prefix)) message += " (for " + stream_prefix + " " + in_quotes(stream_name) + ")";
@@ -1191,11 +1200,17 @@ class Parser {
 
   OutputConfig parse_output(const toml::node& node, const std::string& prefix, const std::vector<StreamConfig>& streams) const {
     const toml::table& t = table_of(node, prefix, "[[output]]");
-    check_keys(t, prefix, kOutputKeys);
     auto key = [&](std::string_view name) { return join_key(prefix, name); };
     OutputConfig o;
-    if (const toml::node* n = t.get("encoding"))
-      o.encoding = get_choice<WireEncoding>(*n, key("encoding"), {{"binary", WireEncoding::kBinary}, {"json", WireEncoding::kJson}});
+    // The encoding first: it may accept keys of its own.
+    if (const toml::node* n = t.get("encoding")) {
+      std::vector<Choice<const OutputEncoder*>> encoders;
+      for (const OutputEncoder* e : output_encoders()) encoders.push_back({e->name(), e});
+      o.encoder = get_choice<const OutputEncoder*>(*n, key("encoding"), encoders);
+    }
+    std::vector<std::string_view> known(std::begin(kOutputKeys), std::end(kOutputKeys));
+    for (std::string_view k : o.encoder->config_keys()) known.push_back(k);
+    check_keys(t, prefix, known);
 
     const toml::node& dest_node = require(t, "destinations", prefix);
     if (!dest_node.is_array()) wrong_type(dest_node, key("destinations"), "an array of strings");

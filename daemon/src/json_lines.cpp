@@ -6,8 +6,12 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
+
+#include "posefair/daemon/output_encoder.hpp"
 
 namespace posefair::daemon {
 namespace {
@@ -519,6 +523,30 @@ DecodeResult decode_json(std::string_view text) {
 
 DecodeResult decode_json(std::span<const std::uint8_t> datagram) {
   return decode_json(std::string_view(reinterpret_cast<const char*>(datagram.data()), datagram.size()));
+}
+
+namespace {
+
+// [[output]] encoding = "json": one JSON line per datagram. It builds a std::string per pose,
+// so it allocates on the publisher thread (the JSON lines are a convenience, not the real-time
+// path); the copy into the publisher's buffer keeps the interface one for every encoding.
+class JsonLinesOutputEncoder final : public OutputEncoder {
+ public:
+  std::string_view name() const override { return "json"; }
+  std::size_t encode(const PoseMessage& m, std::span<std::uint8_t> out) const override {
+    const std::string line = encode_json(m);
+    if (out.size() < line.size()) throw std::length_error("encode_json: output buffer too small");
+    std::copy(line.begin(), line.end(), out.begin());
+    return line.size();
+  }
+};
+
+}  // namespace
+
+// Registered in output_encoder_registry.cpp.
+const OutputEncoder& json_lines_output_encoder() {
+  static const JsonLinesOutputEncoder encoder;
+  return encoder;
 }
 
 }  // namespace posefair::daemon

@@ -10,8 +10,10 @@
 #include <ctime>
 #include <filesystem>
 #include <stdexcept>
+#include <system_error>
 #include <utility>
 
+#include "posefair/core/error.hpp"
 #include "posefair/core/fairing_window.hpp"
 #include "posefair/core/fixed_rate_resampler.hpp"
 #include "posefair/core/gap_bridge.hpp"
@@ -32,7 +34,7 @@ std::filesystem::path expand_time_pattern(const std::filesystem::path& path) {
   ::localtime_r(&now, &local);
   char buf[512];
   const std::size_t n = std::strftime(buf, sizeof buf, name.c_str(), &local);
-  if (n == 0) throw std::runtime_error("recorder: cannot expand the time pattern in " + path.string());
+  if (n == 0) throw Error(ErrorKind::CantCreate, "recorder: cannot expand the time pattern in " + path.string(), "recorder.path");
   return path.parent_path() / std::string(buf, n);
 }
 
@@ -115,11 +117,26 @@ Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
   std::vector<std::uint32_t> ids;
   for (std::size_t i = 0; i < config_.streams.size(); ++i) {
     const StreamConfig& sc = config_.streams[i];
-    MadeDriver made = make_driver(sc);
+    // A source that cannot be used is a configuration error at the stream's key.
+    const std::string stream_key = "stream[" + std::to_string(i + 1) + "]";
+    MadeDriver made;
+    try {
+      made = make_driver(sc);
+    } catch (const std::system_error&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      throw Error(ErrorKind::Config, e.what(), stream_key + ".driver");
+    }
     for (std::string& w : made.warnings) warnings_.push_back("stream '" + sc.name + "': " + w);
     header_.streams.push_back(formats::StreamInfo{sc.id, sc.name, made.source});
     streams_.push_back(std::make_unique<Stream>(*this, sc, std::move(made), static_cast<std::uint32_t>(i), record));
-    streams_.back()->gpio = make_gpio_lines(sc, *streams_.back());
+    try {
+      streams_.back()->gpio = make_gpio_lines(sc, *streams_.back());
+    } catch (const std::system_error&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      throw Error(ErrorKind::Config, e.what(), stream_key + ".gpio");
+    }
     ids.push_back(sc.id);
   }
   publisher_ = std::make_unique<Publisher>(session, ids, config_.outputs, first_sequence);
@@ -132,7 +149,7 @@ Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
     try {
       writer_ = std::make_unique<formats::SampleLogWriter>(expand_time_pattern(config_.recorder.path), header_, wo);
     } catch (const formats::SampleLogError& e) {
-      throw std::runtime_error(std::string("recorder: ") + e.what());
+      throw Error(ErrorKind::CantCreate, std::string("recorder: ") + e.what(), "recorder.path");
     }
   }
 }

@@ -1,6 +1,7 @@
 // posefaird: the posefair service (docs/operations.md).
 #include <CLI/CLI.hpp>
 
+#include "posefair/core/error.hpp"
 #include "posefair/daemon/service.hpp"
 
 int main(int argc, char** argv) {
@@ -16,7 +17,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 64;  // EX_USAGE
+    return app.exit(e) == 0 ? 0 : posefair::exit_code(posefair::ErrorKind::Usage);
   }
   o.config = config;
   return posefair::daemon::run_service(o);

@@ -5,14 +5,13 @@
 #include <cmath>
 #include <string>
 
-#include "posefair/daemon/json_lines.hpp"
 
 namespace posefair::daemon {
 
 Publisher::Publisher(std::uint32_t session, std::vector<std::uint32_t> stream_ids,
                      const std::vector<OutputConfig>& outputs,
                      const std::map<std::uint32_t, std::uint64_t>& first_sequence)
-    : session_(session), binary_(kMaxDatagramSize) {
+    : session_(session) {
   streams_.resize(stream_ids.size());
   for (std::size_t i = 0; i < stream_ids.size(); ++i) {
     streams_[i].id = stream_ids[i];
@@ -24,7 +23,15 @@ Publisher::Publisher(std::uint32_t session, std::vector<std::uint32_t> stream_id
     for (std::uint32_t id : oc.streams)
       for (std::size_t i = 0; i < stream_ids.size(); ++i)
         if (stream_ids[i] == id) carries[i] = 1;
-    outputs_.push_back(Output{oc.encoding, oc.angular_velocity, std::move(carries), UdpSender(oc.destinations, oc.send)});
+    const auto shared = std::find_if(encoded_.begin(), encoded_.end(), [&](const Encoded& e) { return e.encoder == oc.encoder; });
+    const auto encoded = static_cast<std::size_t>(shared - encoded_.begin());
+    if (shared == encoded_.end()) {
+      Encoded e;
+      e.encoder = oc.encoder;
+      e.buffer.resize(kMaxDatagramSize);
+      encoded_.push_back(std::move(e));
+    }
+    outputs_.push_back(Output{encoded, oc.angular_velocity, std::move(carries), UdpSender(oc.destinations, oc.send)});
   }
 }
 
@@ -50,32 +57,18 @@ Publisher::Result Publisher::publish(const RingPose& pose) {
   st.previous = m.orientation;
 
   m.send_time = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-  std::size_t binary_size = 0;
-  bool binary_with_rate = false;
-  std::string json;
-  bool json_with_rate = false;
-  bool json_done = false;
+  for (Encoded& e : encoded_) e.size = 0;
   for (Output& out : outputs_) {
     if (!out.carries[pose.stream_index]) continue;
     result.carried = true;
     m.angular_velocity = out.angular_velocity ? rate : std::nullopt;
     const bool with_rate = m.angular_velocity.has_value();
-    std::span<const std::uint8_t> datagram;
-    if (out.encoding == WireEncoding::kBinary) {
-      if (binary_size == 0 || binary_with_rate != with_rate) {
-        binary_size = encode_binary(m, binary_);
-        binary_with_rate = with_rate;
-      }
-      datagram = std::span<const std::uint8_t>(binary_.data(), binary_size);
-    } else {
-      // JSON lines are for convenience, not for the real-time path's allocation budget.
-      if (!json_done || json_with_rate != with_rate) {
-        json = encode_json(m);
-        json_with_rate = with_rate;
-        json_done = true;
-      }
-      datagram = std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(json.data()), json.size());
+    Encoded& e = encoded_[out.encoded];
+    if (e.size == 0 || e.with_rate != with_rate) {
+      e.size = e.encoder->encode(m, e.buffer);
+      e.with_rate = with_rate;
     }
+    const std::span<const std::uint8_t> datagram(e.buffer.data(), e.size);
     const std::size_t sent = out.sender.send(datagram);
     result.failures += out.sender.destinations().size() - sent;
   }

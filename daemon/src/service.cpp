@@ -18,6 +18,7 @@
 #include <string>
 #include <system_error>
 
+#include "posefair/core/error.hpp"
 #include "posefair/daemon/config.hpp"
 #include "posefair/daemon/pipeline.hpp"
 #include "posefair/daemon/status_report.hpp"
@@ -63,19 +64,23 @@ std::uint32_t random_session() {
 
 void notify(const std::string& message) { ::sd_notify(0, message.c_str()); }
 
-// Builds a pipeline, mapping its failures onto exit codes (0 = built).
+// Builds a pipeline, mapping its failures onto exit codes by their kind (0 = built): an Error
+// says its kind; a socket the OS refused (std::system_error) is OsErr; any other runtime_error
+// from a source is an unusable source named in the configuration, Config.
 int build(const DaemonConfig& config, std::uint32_t session, const std::map<std::uint32_t, std::uint64_t>& sequences,
           bool defer_recorder, std::unique_ptr<Pipeline>& out) {
   try {
     out = std::make_unique<Pipeline>(config, session, sequences, defer_recorder);
     return kExitOk;
+  } catch (const Error& e) {
+    spdlog::error("{}: {}", config.source_file.string(), e.what());
+    return e.exit_code();
   } catch (const std::system_error& e) {
     spdlog::error("{}: {}", config.source_file.string(), e.what());
-    return kExitOsError;
+    return exit_code(ErrorKind::OsErr);
   } catch (const std::runtime_error& e) {
-    const std::string what = e.what();
-    spdlog::error("{}: {}", config.source_file.string(), what);
-    return what.rfind("recorder:", 0) == 0 ? kExitCantCreate : kExitConfig;
+    spdlog::error("{}: {}", config.source_file.string(), e.what());
+    return exit_code(ErrorKind::Config);
   }
 }
 
@@ -99,7 +104,7 @@ class Service {
       config = load_config(options_.config);
     } catch (const ConfigError& e) {
       std::fprintf(stderr, "posefaird: %s\n", e.what());
-      return kExitConfig;
+      return e.exit_code();
     }
     setup_logging(config.logging, options_);
     session_ = config.daemon.session_id ? *config.daemon.session_id : random_session();
@@ -242,7 +247,7 @@ int run_service(const ServiceOptions& options) {
     return Service(options).run();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "posefaird: internal error: %s\n", e.what());
-    return kExitSoftware;
+    return exit_code(ErrorKind::Software);
   }
 }
 

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "posefair/daemon/json_lines.hpp"
+#include "posefair/daemon/output_encoder.hpp"
 
 namespace posefair::daemon {
 namespace {
@@ -168,6 +169,23 @@ bool bitwise_equal(const PoseMessage& a, const PoseMessage& b) {
          same_bits(a.orientation.w(), b.orientation.w()) && same_bits(a.orientation.x(), b.orientation.x()) &&
          same_bits(a.orientation.y(), b.orientation.y()) && same_bits(a.orientation.z(), b.orientation.z()) &&
          same_bits(a.position, b.position) && same_bits(a.angular_velocity, b.angular_velocity);
+}
+
+namespace {
+
+// [[output]] encoding = "binary": the v1 datagram, written into the publisher's buffer.
+class BinaryOutputEncoder final : public OutputEncoder {
+ public:
+  std::string_view name() const override { return "binary"; }
+  std::size_t encode(const PoseMessage& m, std::span<std::uint8_t> out) const override { return encode_binary(m, out); }
+};
+
+}  // namespace
+
+// Registered in output_encoder_registry.cpp.
+const OutputEncoder& binary_output_encoder() {
+  static const BinaryOutputEncoder encoder;
+  return encoder;
 }
 
 }  // namespace posefair::daemon

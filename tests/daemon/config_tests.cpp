@@ -263,7 +263,7 @@ TEST(Config, AFullConfigFillsEveryField) {
   ASSERT_EQ(c.outputs.size(), 2u);
   {
     const OutputConfig& o = c.outputs[0];
-    EXPECT_EQ(o.encoding, WireEncoding::kJson);
+    EXPECT_EQ(o.encoder->name(), "json");
     ASSERT_EQ(o.destinations.size(), 3u);
     EXPECT_EQ(o.destinations[0], endpoint("127.0.0.1:5700"));  // the default port
     EXPECT_EQ(o.destinations[1], endpoint("[::1]:6000"));
@@ -276,7 +276,7 @@ TEST(Config, AFullConfigFillsEveryField) {
   }
   {
     const OutputConfig& o = c.outputs[1];
-    EXPECT_EQ(o.encoding, WireEncoding::kBinary);
+    EXPECT_EQ(o.encoder->name(), "binary");
     ASSERT_EQ(o.destinations.size(), 1u);
     EXPECT_EQ(o.destinations[0], endpoint("10.0.0.2:5701"));
     EXPECT_EQ(o.send.multicast_ttl, 1);
@@ -807,7 +807,7 @@ TEST(Config, TheDemoConfigReplaysTheBundledExcerpt) {
   EXPECT_DOUBLE_EQ(s.engine.epsilon_r, 0.01);
   EXPECT_DOUBLE_EQ(s.engine.epsilon_t, 0.002);
   ASSERT_EQ(c.outputs.size(), 1u);
-  EXPECT_EQ(c.outputs[0].encoding, WireEncoding::kBinary);
+  EXPECT_EQ(c.outputs[0].encoder->name(), "binary");
   ASSERT_EQ(c.outputs[0].destinations.size(), 1u);
   EXPECT_EQ(c.outputs[0].destinations[0], endpoint("127.0.0.1:5700"));
   // The replay driver reads the file with the options as configured.

@@ -58,7 +58,8 @@ struct WindowConfig {
 // Largest accepted smoothing weight μ (see validate()).
 inline constexpr double kMaxSmoothing = 1e10;
 
-// Throws std::invalid_argument naming the field and its valid range. The constructor also
+// Throws InvalidEngineSetting (core/engine_setting.hpp, a std::invalid_argument) naming the
+// field and its valid range, and the field as setting(). The constructor also
 // refuses a continuity κ > 0 that would make the output recursion unstable.
 void validate(const WindowConfig& config);
 

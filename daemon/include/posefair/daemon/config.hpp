@@ -13,9 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "posefair/core/error.hpp"
 #include "posefair/core/fairing_window.hpp"
 #include "posefair/core/pose_spline.hpp"
 #include "posefair/core/rigid_pose_lerp.hpp"
+#include "posefair/daemon/output_encoder.hpp"
 #include "posefair/daemon/overflow_policy.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
@@ -33,23 +35,21 @@ namespace posefair::daemon {
 // "<file>:<line>:<column>: <key>: <message>" (line and column omitted when unknown, e.g. a
 // missing required key is reported at its table's line). `key` is the dotted TOML path,
 // e.g. "stream[2].engine.window" (array elements numbered from 1 as a user counts them).
-class ConfigError : public std::runtime_error {
+// An Error of kind Config (exit 78); the file, position and key are data, not just text.
+class ConfigError : public Error {
  public:
   ConfigError(std::string file, std::uint32_t line, std::uint32_t column, std::string key, std::string message);
   const std::string& file() const noexcept { return file_; }
   std::uint32_t line() const noexcept { return line_; }      // 0 = unknown
   std::uint32_t column() const noexcept { return column_; }  // 0 = unknown
-  const std::string& key() const noexcept { return key_; }
   const std::string& message() const noexcept { return message_; }
 
  private:
   std::string file_;
   std::uint32_t line_;
   std::uint32_t column_;
-  std::string key_;
   std::string message_;
 };
-
 
 enum class LogTarget { Auto, Stderr, Journald };  // Auto: journald when JOURNAL_STREAM says stderr is the journal
 
@@ -188,7 +188,7 @@ struct StreamConfig {
 };
 
 struct OutputConfig {
-  WireEncoding encoding = WireEncoding::kBinary;  // "binary" or "json"
+  const OutputEncoder* encoder = output_encoders().front();  // `encoding`: a registered name; default "binary"
   std::vector<Endpoint> destinations;              // unicast and multicast, IPv4 and IPv6; at least one
   SendOptions send;                                // ttl (default 1), interface, loopback
   std::vector<std::uint32_t> streams;              // the streams this output carries; empty = all

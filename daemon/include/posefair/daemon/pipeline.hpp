@@ -39,8 +39,9 @@ class Pipeline {
   // sockets, the recording file (unless adopt_recorder() will hand one over). A recorder path
   // containing '%' is expanded by strftime at the local time now ("run-%Y%m%d-%H%M%S.pflog"),
   // so a service restarted by systemd starts a new file instead of refusing an existing one. Throws
-  // std::runtime_error (or std::system_error for sockets) with a message naming the stream
-  // or output. `session` and `first_sequence` continue the wire protocol across reloads.
+  // posefair::Error naming the stream or output: of kind Config (an unusable source, with the
+  // stream's key) or CantCreate (the recording, key "recorder.path"); std::system_error for a
+  // socket the OS refused. `session` and `first_sequence` continue the wire protocol across reloads.
   Pipeline(const DaemonConfig& config, std::uint32_t session, const std::map<std::uint32_t, std::uint64_t>& first_sequence,
            bool defer_recorder = false, PipelineHooks hooks = {});
   ~Pipeline();

@@ -1,7 +1,8 @@
 #pragma once
-// The publisher: turns faired poses into wire protocol v1 datagrams (binary or JSON lines,
-// docs/protocol.md) and sends each to every destination of every output that carries its
-// stream. Owns the per-stream wire sequence numbers (0 at session start, +1 per pose; carried
+// The publisher: turns faired poses into datagrams, each output through the encoder its config
+// chose (daemon/output_encoder.hpp: wire protocol v1 binary or JSON lines, docs/protocol.md), and
+// sends each to every destination of every output that carries its stream. A pose is encoded
+// once per encoder (and angular-velocity choice), however many outputs share it. Owns the per-stream wire sequence numbers (0 at session start, +1 per pose; carried
 // over a SIGHUP reload) and the previous pose per stream for the optional angular velocity.
 // Runs on the publisher thread only; sockets are non-blocking, so a slow network never stalls
 // it (a full socket buffer is a counted send failure).
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "posefair/daemon/config.hpp"
+#include "posefair/daemon/output_encoder.hpp"
 #include "posefair/daemon/ring_items.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
@@ -41,10 +43,17 @@ class Publisher {
 
  private:
   struct Output {
-    WireEncoding encoding;
+    std::size_t encoded;  // index into encoded_: the datagram of this output's encoder
     bool angular_velocity;
     std::vector<char> carries;  // per stream index
     UdpSender sender;
+  };
+  // One per distinct encoder among the outputs: its datagram for the pose being published.
+  struct Encoded {
+    const OutputEncoder* encoder = nullptr;
+    std::vector<std::uint8_t> buffer;  // kMaxDatagramSize bytes, allocated once
+    std::size_t size = 0;              // 0: not encoded for this pose yet
+    bool with_rate = false;            // encoded with the angular velocity
   };
   struct StreamState {
     std::uint32_t id = 0;
@@ -56,7 +65,7 @@ class Publisher {
   std::uint32_t session_;
   std::vector<Output> outputs_;
   std::vector<StreamState> streams_;
-  std::vector<std::uint8_t> binary_;  // scratch for the binary encoding
+  std::vector<Encoded> encoded_;
 };
 
 }  // namespace posefair::daemon

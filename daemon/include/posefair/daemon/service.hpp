@@ -8,19 +8,15 @@
 //                    fixed: then the session stays and sequences continue), a bad one is logged
 //                    and the running one kept;
 //   SIGUSR1          log every stream's counters now.
-// docs/operations.md describes it for operators.
+// docs/operations.md describes it for operators. The exit status is exit_code() of the failure's
+// ErrorKind (core/error.hpp): Config (78) for a bad configuration or an unusable source, OsErr
+// (71) for a socket that cannot be opened, CantCreate (73) for a recording that cannot be
+// created, Software (70) for an internal error.
 #include <filesystem>
 #include <optional>
 #include <string>
 
 namespace posefair::daemon {
-
-// sysexits.h values posefaird exits with.
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitSoftware = 70;  // an internal error
-inline constexpr int kExitOsError = 71;   // a socket could not be opened
-inline constexpr int kExitCantCreate = 73;  // the recording could not be created
-inline constexpr int kExitConfig = 78;    // EX_CONFIG: the configuration is bad (or names an unusable source)
 
 struct ServiceOptions {
   std::filesystem::path config;
