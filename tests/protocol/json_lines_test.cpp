@@ -110,14 +110,14 @@ TEST(JsonLines, RejectsMalformedJsonAsSyntaxErrors) {
       R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":"\u12"})",  // short \u
       R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":"\udc00"})",  // lone surrogate
       R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":"\ud800x"})",
-      std::string(R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":")") + '\x01' + "\"}",
+      R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":")" "\x01\"}",
       R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":)" + std::string(16, '[') +
           std::string(16, ']') + "}",  // 17 nested containers with the top object
       // Invalid UTF-8 in a string: a stray byte, an overlong '/', a cut sequence, a UTF-16 surrogate.
-      std::string(R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":")") + "\xff\"}",
-      std::string(R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":")") + "\xc0\xaf\"}",
-      std::string(R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":")") + "\xe2\x82\"}",
-      std::string(R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":")") + "\xed\xa0\x80\"}",
+      R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":")" "\xff\"}",
+      R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":")" "\xc0\xaf\"}",
+      R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":")" "\xe2\x82\"}",
+      R"({"v":1,"session":1,"stream":2,"seq":3,"t":0.5,"sent":0,"q":[1,0,0,0],"x":")" "\xed\xa0\x80\"}",
   };
   for (const std::string& s : bad) EXPECT_EQ(error_of(s), DecodeError::kJsonSyntax) << s;
 }
