@@ -12,6 +12,7 @@
 #include <limits>
 #include <memory>
 
+#include "benchmark_data.hpp"
 #include "posefair/core/error.hpp"
 #include "posefair/core/causal_fairing.hpp"
 #include "posefair/core/exponential_slerp_filter.hpp"
@@ -207,7 +208,7 @@ const Result* best(const std::vector<Result>& rs, const std::string& dataset, co
 int bench_quality(const std::string& data_dir, const std::string& out_dir, bool quick) {
   std::vector<QualityDataset> sets;
   try {
-    sets = load_quality_datasets(data_dir, quick);
+    sets = load_quality_datasets(data_dir, quick, std::cerr);
   } catch (const std::exception& e) {
     std::cerr << "posefair bench quality: " << e.what() << "\n";
     return exit_code(ErrorKind::NoInput);
@@ -271,10 +272,10 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   auto* bench = app.add_subcommand("bench", "Measure posefair against reference filters");
   bench->require_subcommand(1);
   auto* quality = bench->add_subcommand("quality", "Accuracy, jitter and lag on synthetic and recorded data");
-  auto data = std::make_shared<std::string>("../shared/data");
+  auto data = std::make_shared<std::string>(benchmark_data_dir().string());  // $POSEFAIR_DATA or ../shared/data
   auto out = std::make_shared<std::string>("build/bench-quality");
   auto quick = std::make_shared<bool>(false);
-  quality->add_option("--data", *data, "folder with the recorded data sets (tum/, broad/, bvh/)")->capture_default_str();
+  quality->add_option("--data", *data, "folder with the recorded data sets (tum/, broad/, bvh/); default $POSEFAIR_DATA, else ../shared/data")->capture_default_str();
   quality->add_option("-o,--output", *out, "folder for quality-runs.csv and quality-summary.csv")->capture_default_str();
   quality->add_flag("--quick", *quick, "synthetic data only, fewer configurations (seconds, for tests)");
   quality->callback([=, &exit_code] { exit_code = bench_quality(*data, *out, *quick); });

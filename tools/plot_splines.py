@@ -12,6 +12,7 @@ writes the body-frame angular velocity and acceleration CSV), and plots those ag
 trial's own 285.7 Hz gyroscope. Needs python3-matplotlib.
 """
 import csv
+import os
 import subprocess
 import sys
 import tempfile
@@ -22,13 +23,19 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-DATA = Path(__file__).resolve().parent.parent.parent / "shared/data/broad/07_undisturbed_fast_rotation_B.csv"
+# The full trial, not part of the repository: in $POSEFAIR_DATA, else in ../shared/data beside the project.
+DATA_DIR = Path(os.environ.get("POSEFAIR_DATA") or Path(__file__).resolve().parent.parent.parent / "shared/data")
+DATA = DATA_DIR / "broad/07_undisturbed_fast_rotation_B.csv"
 START, LENGTH, DECIMATE = 30.0, 3.0, 10
 
 
 def main():
     posefair, out_dir = Path(sys.argv[1]), Path(sys.argv[2])
     data = sys.argv[3] if len(sys.argv) > 3 else DATA
+    if not Path(data).exists():
+        sys.exit(f"plot_splines.py: {data} not found; it comes from BROAD (Laidig et al., Data 6(7):72, 2021, "
+                 "doi:10.3390/data6070072, CC BY 4.0). Set POSEFAIR_DATA to the folder with broad/, or put it in "
+                 "../shared/data beside the project (docs/benchmarks.md).")
     rows = []
     with open(data, newline="") as f:
         for r in csv.DictReader(f):

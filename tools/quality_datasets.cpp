@@ -4,10 +4,13 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
+#include <ostream>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 
+#include "benchmark_data.hpp"
 #include "posefair/core/quality_metrics.hpp"
 #include "posefair/core/synthetic_motion.hpp"
 #include "posefair/formats/pose_file.hpp"
@@ -133,18 +136,44 @@ QualityDataset bvh(const std::filesystem::path& path, const std::string& joint, 
 
 }  // namespace
 
-std::vector<QualityDataset> load_quality_datasets(const std::filesystem::path& dir, bool quick) {
+std::vector<QualityDataset> load_quality_datasets(const std::filesystem::path& dir, bool quick, std::ostream& notes) {
   std::vector<QualityDataset> sets;
   for (double rate : {100.0, 1000.0})
     for (double noise : {0.01, 0.05}) sets.push_back(synthetic(rate, noise, quick));
   if (quick) return sets;
-  sets.push_back(tum(dir / "tum/freiburg1_xyz-rgbdslam.txt", dir / "tum/freiburg1_xyz-groundtruth.txt", "tum-fr1xyz-rgbdslam"));
-  sets.push_back(tum(dir / "tum/fr2_desk_ORB.txt", dir / "tum/fr2_desk_groundtruth.txt", "tum-fr2desk-orb"));
-  sets.push_back(broad(dir / "broad/07_undisturbed_fast_rotation_B.csv", "broad-07-fast-rotation"));
-  sets.push_back(broad(dir / "broad/02_undisturbed_slow_rotation_B.csv", "broad-02-slow-rotation"));
-  sets.push_back(bvh(dir / "bvh/01_01.bvh", "LeftArm", 0.02, "bvh-01_01-LeftArm-noise0.02"));
-  sets.push_back(bvh(dir / "bvh/01_01.bvh", "RightUpLeg", 0.02, "bvh-01_01-RightUpLeg-noise0.02"));
-  sets.push_back(bvh(dir / "bvh/Boxing_Toes.bvh", "RightShoulder", 0.02, "bvh-boxing-RightShoulder-noise0.02"));
+  // The recorded sets are read in full from dir. One whose files are missing is skipped with a
+  // line saying where it comes from; none of them there at all is an error.
+  const std::initializer_list<std::string_view> all_files = {
+      "tum/freiburg1_xyz-rgbdslam.txt", "tum/freiburg1_xyz-groundtruth.txt", "tum/fr2_desk_ORB.txt",
+      "tum/fr2_desk_groundtruth.txt", "broad/07_undisturbed_fast_rotation_B.csv",
+      "broad/02_undisturbed_slow_rotation_B.csv", "bvh/01_01.bvh", "bvh/Boxing_Toes.bvh"};
+  if (std::none_of(all_files.begin(), all_files.end(), [&](std::string_view f) { return std::filesystem::exists(dir / f); })) {
+    std::string m = "no recorded data set found in " + dir.string() + ":";
+    for (std::string_view f : all_files) m += "\n  " + missing_file_line(dir, f);
+    throw std::runtime_error(m + "\n" + where_benchmark_data_is_looked_for());
+  }
+  const auto present = [&](const std::string& name, std::initializer_list<std::string_view> files) {
+    for (std::string_view f : files)
+      if (!std::filesystem::exists(dir / f)) {
+        notes << "posefair bench quality: skipping " << name << ": " << missing_file_line(dir, f) << "\n";
+        return false;
+      }
+    return true;
+  };
+  if (present("tum-fr1xyz-rgbdslam", {"tum/freiburg1_xyz-rgbdslam.txt", "tum/freiburg1_xyz-groundtruth.txt"}))
+    sets.push_back(tum(dir / "tum/freiburg1_xyz-rgbdslam.txt", dir / "tum/freiburg1_xyz-groundtruth.txt", "tum-fr1xyz-rgbdslam"));
+  if (present("tum-fr2desk-orb", {"tum/fr2_desk_ORB.txt", "tum/fr2_desk_groundtruth.txt"}))
+    sets.push_back(tum(dir / "tum/fr2_desk_ORB.txt", dir / "tum/fr2_desk_groundtruth.txt", "tum-fr2desk-orb"));
+  if (present("broad-07-fast-rotation", {"broad/07_undisturbed_fast_rotation_B.csv"}))
+    sets.push_back(broad(dir / "broad/07_undisturbed_fast_rotation_B.csv", "broad-07-fast-rotation"));
+  if (present("broad-02-slow-rotation", {"broad/02_undisturbed_slow_rotation_B.csv"}))
+    sets.push_back(broad(dir / "broad/02_undisturbed_slow_rotation_B.csv", "broad-02-slow-rotation"));
+  if (present("bvh-01_01-LeftArm-noise0.02", {"bvh/01_01.bvh"}))
+    sets.push_back(bvh(dir / "bvh/01_01.bvh", "LeftArm", 0.02, "bvh-01_01-LeftArm-noise0.02"));
+  if (present("bvh-01_01-RightUpLeg-noise0.02", {"bvh/01_01.bvh"}))
+    sets.push_back(bvh(dir / "bvh/01_01.bvh", "RightUpLeg", 0.02, "bvh-01_01-RightUpLeg-noise0.02"));
+  if (present("bvh-boxing-RightShoulder-noise0.02", {"bvh/Boxing_Toes.bvh"}))
+    sets.push_back(bvh(dir / "bvh/Boxing_Toes.bvh", "RightShoulder", 0.02, "bvh-boxing-RightShoulder-noise0.02"));
   return sets;
 }
 

@@ -3,6 +3,7 @@
 // truth, TUM SLAM estimates against motion capture, BROAD optical orientation against its
 // gyroscope, and BVH joints with added noise against the clean file.
 #include <filesystem>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -20,8 +21,10 @@ struct QualityDataset {
   double rate_hz = 0.0;        // nominal (median) sample rate
 };
 
-// Loads every data set; the recorded ones from data_dir (../shared/data). quick: the synthetic
-// ones only, shorter. Throws std::runtime_error naming a file that is missing or malformed.
-std::vector<QualityDataset> load_quality_datasets(const std::filesystem::path& data_dir, bool quick);
+// Loads every data set; the recorded ones in full from data_dir ($POSEFAIR_DATA or
+// ../shared/data, benchmark_data.hpp). quick: the synthetic ones only, shorter. A recorded set
+// with a missing file is skipped with a line on notes; throws std::runtime_error naming a file
+// that is malformed, or, when no recorded file is there at all, every file and where it comes from.
+std::vector<QualityDataset> load_quality_datasets(const std::filesystem::path& data_dir, bool quick, std::ostream& notes);
 
 }  // namespace posefair::tools

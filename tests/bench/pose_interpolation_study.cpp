@@ -9,7 +9,8 @@
 // Intervals across a dropout (a step over 1.5 m median intervals) are not scored. Prints RMS
 // rotation error (degrees) and RMS position error (mm for TUM and BROAD, 1e-3 file units for
 // BVH) per data set and m.
-//   build/tests/bench/pose_interpolation_study [data dir, default ../shared/data]
+//   build/tests/bench/pose_interpolation_study [data dir, default $POSEFAIR_DATA or ../shared/data]
+// A data set whose file is missing is skipped with a line; none there at all is an error (exit 66).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "benchmark_data.hpp"
+#include "posefair/core/error.hpp"
 #include "posefair/core/pose_spline.hpp"
 #include "posefair/core/rigid_pose_lerp.hpp"
 #include "posefair/formats/pose_file.hpp"
@@ -113,24 +116,40 @@ void study(const Data& d, std::size_t m) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::filesystem::path dir = argc > 1 ? argv[1] : "../shared/data";
+  const std::filesystem::path dir = argc > 1 ? std::filesystem::path(argv[1]) : posefair::tools::benchmark_data_dir();
   std::vector<Data> sets;
+  std::size_t missing = 0;
+  const auto present = [&](const std::string& relative) {
+    if (std::filesystem::exists(dir / relative)) return true;
+    std::fprintf(stderr, "pose_interpolation_study: skipping %s: %s\n", relative.c_str(),
+                 posefair::tools::missing_file_line(dir, relative).c_str());
+    ++missing;
+    return false;
+  };
   try {
     formats::ReadOptions tum;
     tum.format = formats::PoseFormat::Tum;
     for (const char* f : {"freiburg1_xyz-groundtruth.txt", "fr2_desk_groundtruth.txt", "freiburg1_xyz-rgbdslam.txt", "fr2_desk_ORB.txt"})
-      sets.push_back({std::string("tum/") + f, cleaned(formats::read_pose_file(dir / "tum" / f, tum).poses())});
+      if (present(std::string("tum/") + f))
+        sets.push_back({std::string("tum/") + f, cleaned(formats::read_pose_file(dir / "tum" / f, tum).poses())});
     formats::ReadOptions broad;
     broad.csv_prefix = "gt_";
     broad.skip_missing = true;
     for (const char* f : {"16_undisturbed_fast_translation_B.csv", "21_undisturbed_fast_combined.csv"})
-      sets.push_back({std::string("broad/") + f, cleaned(formats::read_pose_file(dir / "broad" / f, broad).poses())});
+      if (present(std::string("broad/") + f))
+        sets.push_back({std::string("broad/") + f, cleaned(formats::read_pose_file(dir / "broad" / f, broad).poses())});
     formats::ReadOptions bvh;
     bvh.bvh_joint = "Hips";
-    sets.push_back({"bvh/01_01.bvh Hips", cleaned(formats::read_pose_file(dir / "bvh" / "01_01.bvh", bvh).poses(), 1)});
+    if (present("bvh/01_01.bvh"))
+      sets.push_back({"bvh/01_01.bvh Hips", cleaned(formats::read_pose_file(dir / "bvh" / "01_01.bvh", bvh).poses(), 1)});
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pose_interpolation_study: %s\n", e.what());
     return 1;
+  }
+  if (sets.empty()) {
+    std::fprintf(stderr, "pose_interpolation_study: no recorded data set found in %s (%zu files missing).\n%s\n",
+                 dir.string().c_str(), missing, posefair::tools::where_benchmark_data_is_looked_for().c_str());
+    return posefair::exit_code(posefair::ErrorKind::NoInput);  // as posefair bench quality
   }
   std::printf("RMS error at the held-out samples: rotation (deg) / position (mm; BVH: 1e-3 file units)\n\n");
   std::printf("| data | keep every m (rate) | poses scored | matrix-lerp | slerp+line | spline k=1 | spline k=2 | lerp fallbacks |\n");

@@ -31,14 +31,15 @@ struct GroundTruthRow {
 constexpr double kGtMincutoff = 1.0;
 constexpr double kGtBeta = 0.1;
 constexpr double kGtDcutoff = 1.0;
-const char* const kGroundTruthPath = POSEFAIR_SHARED_DIR "/data/one-euro/groundTruth.csv";
+// Its first 400 rows (0 to 3.3 s: the sine's rise, slow crest and fall), tests/data/one-euro/README.md.
+const char* const kGroundTruthPath = POSEFAIR_SOURCE_DIR "/tests/data/one-euro/groundTruth.csv";
 
 // Fails the calling test (fatally, use with ASSERT_NO_FATAL_FAILURE) if the file is missing or
 // malformed.
 void load_ground_truth(std::vector<GroundTruthRow>& rows) {
   std::ifstream in(kGroundTruthPath);
   ASSERT_TRUE(in.good()) << "One Euro conformance file not found or unreadable: " << kGroundTruthPath
-                         << " (expected the authors' groundTruth.csv in <shared>/data/one-euro/)";
+                         << " (expected the excerpt of the authors' groundTruth.csv in tests/data/one-euro/)";
   std::string line;
   ASSERT_TRUE(std::getline(in, line)) << kGroundTruthPath << " is empty";
   if (!line.empty() && line.back() == '\r') line.pop_back();

@@ -88,8 +88,9 @@ TEST(ResampleCommand, TimesFileCsvOutputAndDerivatives) {
 
 TEST(ResampleCommand, HoldoutOnRealOpticalTrackingBeatsGeodesicInterpolation) {
   // BROAD trial 07 (fast rotation, 285.7 Hz optical tracking): every 10th sample as a knot.
+  // The bundled 7 s excerpt of it (data/demo/SOURCE.md).
   ScratchDir dir;
-  const std::string data = POSEFAIR_SHARED_DIR "/data/broad/07_undisturbed_fast_rotation_B.csv";
+  const std::string data = POSEFAIR_SOURCE_DIR "/data/demo/broad-07-excerpt.csv";
   const auto r = run_posefair("resample '" + data + "' --skip-missing --holdout 10 --order 2", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   double spline_rms = 0, spline_max = 0, geo_rms = 0, geo_max = 0;
