@@ -1,5 +1,7 @@
 #pragma once
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;
+}  // namespace CLI
 
 namespace posefair::tools {
 // `posefair bench quality`: posefair's engine against One Euro and the other reference

@@ -1,5 +1,7 @@
 #include "bench_latency_command.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <sys/resource.h>
 #include <time.h>
 

@@ -1,3 +1,5 @@
+#include <CLI/CLI.hpp>
+
 #include "bench_command.hpp"
 #include "bench_latency_command.hpp"
 

@@ -1,5 +1,7 @@
 #include "camera_command.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>

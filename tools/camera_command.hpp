@@ -1,5 +1,7 @@
 #pragma once
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;
+}  // namespace CLI
 
 namespace posefair::tools {
 // `posefair camera`: camera keyframes -> interpolated camera matrices per frame by Alexa's

@@ -1,5 +1,7 @@
 #include "devices_command.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <array>
 #include <cstdio>

@@ -2,7 +2,9 @@
 // `posefair devices`: the serial ports this machine has, with their USB ids and serial numbers
 // (what a [stream.driver] with type = "serial" names as device or usb), and the protocol
 // decoders this build knows (docs/config.md).
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;
+}  // namespace CLI
 
 #include <string>
 #include <vector>

@@ -1,5 +1,7 @@
 #pragma once
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;
+}  // namespace CLI
 
 namespace posefair::tools {
 // `posefair fair`: batch Lee & Shin fairing of a pose file (docs/fairing.md).

@@ -1,5 +1,7 @@
 #include "reproduce_command.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>

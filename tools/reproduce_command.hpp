@@ -1,5 +1,7 @@
 #pragma once
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;
+}  // namespace CLI
 
 namespace posefair::tools {
 // `posefair reproduce lee-shin`: the Section 6 traces behind docs/fairing.md, as CSV.

@@ -1,5 +1,7 @@
 #include "resample_command.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>

@@ -1,5 +1,7 @@
 #include "spline_command.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <chrono>
 #include <cstdio>
 #include <fstream>

@@ -1,5 +1,7 @@
 #pragma once
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;
+}  // namespace CLI
 
 namespace posefair::tools {
 // `posefair spline`: minimal covariant-acceleration quaternion spline through keyframes

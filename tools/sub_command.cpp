@@ -1,5 +1,7 @@
 #include "sub_command.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <netinet/in.h>
 #include <sys/socket.h>
 

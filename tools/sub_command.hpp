@@ -1,6 +1,8 @@
 #pragma once
 // `posefair sub`: subscribe to posefair poses over UDP (docs/protocol.md, "posefair sub").
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;
+}  // namespace CLI
 
 #include <array>
 #include <bitset>
