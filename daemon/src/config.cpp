@@ -913,23 +913,21 @@ class Parser {
     parse_can_decoder(t, prefix, c);
   }
 
-  // [stream.driver] with type = "replay" and key candump: a candump log decoded by a CAN
-  // protocol decoder (the driver factory decodes it). Timing keys as for any replay.
-  void parse_candump_replay(const toml::table& t, const std::string& prefix, StreamConfig& s) const {
-    auto key = [&](std::string_view name) { return join_key(prefix, name); };
-    ReplaySourceConfig& r = s.driver.replay;
-    const toml::node& log_node = *t.get("candump");
-    for (std::string_view other : {"path", "format", "joint", "csv_prefix", "skip_missing", "source_stream"})
-      if (const toml::node* n = t.get(other))
-        fail(*n, key(other), "not for a candump log (candump is set at line " + std::to_string(log_node.source().begin.line) + ")");
-    r.candump = resolve(get_nonempty_string(log_node, key("candump")));
+  // A path key naming a file that exists and is a regular file (resolved against the config's folder).
+  std::filesystem::path existing_file(const toml::node& n, const std::string& key) const {
+    std::filesystem::path path = resolve(get_nonempty_string(n, key));
     std::error_code ec;
-    const auto status = std::filesystem::status(r.candump, ec);
-    if (!std::filesystem::exists(status)) fail(log_node, key("candump"), "no such file: " + r.candump.string());
-    if (!std::filesystem::is_regular_file(status)) fail(log_node, key("candump"), "not a regular file: " + r.candump.string());
-    if (const toml::node* n = t.get("interface")) r.can.interface = get_interface(*n, key("interface"));
-    drivers::ReplayOptions& o = r.options;
-    o.stream_id = s.id;
+    const auto status = std::filesystem::status(path, ec);
+    if (!std::filesystem::exists(status)) fail(n, key, "no such file: " + path.string());
+    if (!std::filesystem::is_regular_file(status)) fail(n, key, "not a regular file: " + path.string());
+    return path;
+  }
+
+  // The timing keys of every replay (a pose file, a sample log, a candump log).
+  void parse_replay_timing(const toml::table& t, const std::string& prefix, std::uint32_t stream_id,
+                           drivers::ReplayOptions& o) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    o.stream_id = stream_id;
     if (const toml::node* n = t.get("timing"))
       o.timing = get_choice<drivers::ReplayTiming>(*n, key("timing"), {{"original", drivers::ReplayTiming::Original},
                                                                        {"fast", drivers::ReplayTiming::AsFastAsPossible}});
@@ -939,6 +937,20 @@ class Parser {
                                                                              {"receive-time", drivers::ReplaySchedule::ReceiveTime}});
     if (const toml::node* n = t.get("loop")) o.loop = get_bool(*n, key("loop"));
     if (const toml::node* n = t.get("rounds")) o.max_rounds = static_cast<std::uint64_t>(get_int(*n, key("rounds"), 0, kMaxI64));
+  }
+
+  // [stream.driver] with type = "replay" and key candump: a candump log decoded by a CAN
+  // protocol decoder (the driver factory decodes it). Timing keys as for any replay.
+  void parse_candump_replay(const toml::table& t, const std::string& prefix, StreamConfig& s) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    ReplaySourceConfig& r = s.driver.replay;
+    const toml::node& log_node = *t.get("candump");
+    for (std::string_view other : {"path", "format", "joint", "csv_prefix", "skip_missing", "source_stream"})
+      if (const toml::node* n = t.get(other))
+        fail(*n, key(other), "not for a candump log (candump is set at line " + std::to_string(log_node.source().begin.line) + ")");
+    r.candump = existing_file(log_node, key("candump"));
+    if (const toml::node* n = t.get("interface")) r.can.interface = get_interface(*n, key("interface"));
+    parse_replay_timing(t, prefix, s.id, r.options);
     parse_can_decoder(t, prefix, r.can);
   }
 
@@ -1016,22 +1028,9 @@ class Parser {
       for (std::string_view can_key : can_protocols().all_keys())
         if (const toml::node* n = t.get(can_key)) fail(*n, key(can_key), "only for a candump log (key candump)");
       const toml::node& path_node = require(t, "path", prefix);
-      r.path = resolve(get_nonempty_string(path_node, key("path")));
-      std::error_code ec;
-      const auto status = std::filesystem::status(r.path, ec);
-      if (!std::filesystem::exists(status)) fail(path_node, key("path"), "no such file: " + r.path.string());
-      if (!std::filesystem::is_regular_file(status)) fail(path_node, key("path"), "not a regular file: " + r.path.string());
+      r.path = existing_file(path_node, key("path"));
       drivers::ReplayOptions& o = r.options;
-      o.stream_id = s.id;
-      if (const toml::node* n = t.get("timing"))
-        o.timing = get_choice<drivers::ReplayTiming>(*n, key("timing"), {{"original", drivers::ReplayTiming::Original},
-                                                                         {"fast", drivers::ReplayTiming::AsFastAsPossible}});
-      if (const toml::node* n = t.get("speed")) o.speed = get_float(*n, key("speed"), kPositive);
-      if (const toml::node* n = t.get("schedule"))
-        o.schedule = get_choice<drivers::ReplaySchedule>(*n, key("schedule"), {{"time", drivers::ReplaySchedule::Time},
-                                                                               {"receive-time", drivers::ReplaySchedule::ReceiveTime}});
-      if (const toml::node* n = t.get("loop")) o.loop = get_bool(*n, key("loop"));
-      if (const toml::node* n = t.get("rounds")) o.max_rounds = static_cast<std::uint64_t>(get_int(*n, key("rounds"), 0, kMaxI64));
+      parse_replay_timing(t, prefix, s.id, o);
       if (const toml::node* n = t.get("format")) {
         o.pose.format = get_choice<std::optional<formats::PoseFormat>>(
             *n, key("format"),
