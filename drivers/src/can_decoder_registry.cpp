@@ -1,6 +1,5 @@
 // The CAN decoder registry: one line per protocol (can_decoder.hpp), as decoder_registry.cpp
 // is for the serial ones. A new protocol is one <protocol>_decoder.cpp (with its CanDecoderEntry) plus one line here.
-#include <algorithm>
 #include <charconv>
 #include <stdexcept>
 #include <string>
@@ -8,6 +7,7 @@
 #include "posefair/drivers/can_decoder.hpp"
 #include "posefair/drivers/dronecan_ahrs_decoder.hpp"
 #include "posefair/drivers/posefair_can_decoder.hpp"
+#include "posefair/drivers/registry_lookup.hpp"
 #include "posefair/drivers/xsens_can_decoder.hpp"
 
 namespace posefair::drivers {
@@ -24,23 +24,14 @@ const CanDecoderEntry* const kCanDecoders[] = {
 
 std::span<const CanDecoderEntry* const> can_decoder_entries() { return kCanDecoders; }
 
-const CanDecoderEntry* find_can_decoder(std::string_view protocol) {
-  for (const CanDecoderEntry* e : kCanDecoders)
-    if (e->name == protocol) return e;
-  return nullptr;
-}
+const CanDecoderEntry* find_can_decoder(std::string_view protocol) { return find_entry<CanDecoderEntry>(kCanDecoders, protocol); }
 
 std::unique_ptr<CanDecoder> make_can_decoder(std::string_view protocol, const OptionMap& options) {
   const CanDecoderEntry* e = find_can_decoder(protocol);
   return e ? e->make(options) : nullptr;
 }
 
-std::vector<std::string> can_decoder_protocols() {
-  std::vector<std::string> names;
-  for (const CanDecoderEntry* e : kCanDecoders) names.emplace_back(e->name);
-  std::sort(names.begin(), names.end());
-  return names;
-}
+std::vector<std::string> can_decoder_protocols() { return entry_names<CanDecoderEntry>(kCanDecoders); }
 
 std::uint32_t parse_can_id_option(std::string_view option, std::string_view text, std::uint32_t max) {
   std::string_view digits = text;
