@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "posefair/core/error.hpp"
+#include "posefair/daemon/output_encoder.hpp"
 #include "posefair/drivers/can_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
 #include "posefair/drivers/hid_report_decoder.hpp"
@@ -49,7 +50,8 @@ std::string format_registry(std::string_view title, std::span<const Entry* const
 std::string format_protocols() {
   return format_registry("serial protocols (type = \"serial\")", drivers::decoder_entries()) +
          format_registry("CAN protocols (type = \"socketcan\", or a candump replay)", drivers::can_decoder_entries()) +
-         format_registry("HID protocols (type = \"hid\")", drivers::hid_decoder_entries());
+         format_registry("HID protocols (type = \"hid\")", drivers::hid_decoder_entries()) +
+         format_registry("output encodings ([[output]] encoding)", daemon::output_encoder_entries());
 }
 
 std::string format_devices(const std::vector<drivers::PortInfo>& ports, const std::vector<std::string>& protocols) {

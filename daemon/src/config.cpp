@@ -153,9 +153,9 @@ constexpr std::string_view kHidKeys[] = {"type",        "device",        "usb", 
 constexpr std::string_view kSocketCanKeys[] = {"type", "interface", "protocol", "fd", "time_source", "reconnect_min",
                                                "reconnect_max"};
 
-// One registry of device protocols (serial, CAN or HID) as the configuration sees it: names and
-// the options each declares (drivers/device_options.hpp). The wording of its errors is the
-// kind's own, as it always was.
+// One registry of device protocols (serial, CAN or HID), or the output encodings, as the
+// configuration sees it: names and the options each declares (drivers/device_options.hpp). The
+// wording of its errors is the kind's own, as it always was.
 struct ProtocolInfo {
   std::string_view name;
   std::span<const drivers::OptionSpec> options;
@@ -165,6 +165,8 @@ struct ProtocolKind {
   bool closed_set;        // an unknown name is refused as a choice: "expected one of ..., got 'x'"
   char owner_quote;       // how "only for protocol X" quotes X
   std::vector<ProtocolInfo> protocols;  // sorted by name
+  std::string_view key = "protocol";  // the key that names the entry
+  std::string_view holder = "source";  // "this <holder>'s <key> is ..."
 
   const ProtocolInfo* find(std::string_view name) const {
     for (const ProtocolInfo& p : protocols)
@@ -211,6 +213,10 @@ const ProtocolKind& hid_protocols() {
   static const ProtocolKind kind{"HID protocol", true, '"', protocol_infos(drivers::hid_decoder_entries())};
   return kind;
 }
+const ProtocolKind& output_encodings() {
+  static const ProtocolKind kind{"encoding", true, '\'', protocol_infos(output_encoder_entries()), "encoding", "output"};
+  return kind;
+}
 
 // Each [stream.driver] type: its own keys, and the protocols whose keys it also takes.
 struct DriverKind {
@@ -240,12 +246,15 @@ const std::vector<DriverKind>& driver_kinds() {
   return kinds;
 }
 
+// The first option a table gave for its protocol or encoding, for errors without a key.
+struct OptionsGiven {
+  const toml::node* first_option = nullptr;
+  std::string first_option_key;
+};
 // The protocol a device source named and the options it gave, for check_protocol.
-struct ProtocolGiven {
+struct ProtocolGiven : OptionsGiven {
   const toml::node* node = nullptr;  // the protocol key
   std::string name;
-  const toml::node* first_option = nullptr;  // the first option given, for errors without a key
-  std::string first_option_key;
 };
 
 constexpr std::string_view kOutputKeys[] = {"encoding", "destinations", "ttl",          "interface",
@@ -748,30 +757,40 @@ class Parser {
   // into `out`. The name itself is judged by check_protocol.
   ProtocolGiven parse_protocol_options(const toml::table& t, const std::string& prefix, const ProtocolKind& kind,
                                        drivers::OptionMap& out) const {
-    auto key = [&](std::string_view name) { return join_key(prefix, name); };
     ProtocolGiven g;
     g.node = &require(t, "protocol", prefix);
-    g.name = get_nonempty_string(*g.node, key("protocol"));
-    const ProtocolInfo* own = kind.find(g.name);
+    g.name = get_nonempty_string(*g.node, join_key(prefix, "protocol"));
+    static_cast<OptionsGiven&>(g) = parse_options(t, prefix, kind, g.name, out);
+    return g;
+  }
+
+  // The options of the entry `name` of `kind` in table t, in file order: a key another entry
+  // of the kind declares is refused ("only for protocol 'x'"); each key `name` declares is
+  // type-checked into `out`. Other keys are left to check_keys.
+  OptionsGiven parse_options(const toml::table& t, const std::string& prefix, const ProtocolKind& kind,
+                             const std::string& name, drivers::OptionMap& out) const {
+    auto key = [&](std::string_view k) { return join_key(prefix, k); };
+    OptionsGiven g;
+    const ProtocolInfo* own = kind.find(name);
     // In file order, so that the first problem is the one reported.
     std::vector<std::pair<const toml::key*, const toml::node*>> given;
     for (auto&& [k, v] : t) given.emplace_back(&k, &v);
     std::sort(given.begin(), given.end(), [](const auto& a, const auto& b) { return before(a.first->source().begin, b.first->source().begin); });
     for (const auto& [k, n] : given) {
-      const std::string_view name = k->str();
-      const drivers::OptionSpec* spec = own ? drivers::find_option(own->options, name) : nullptr;
+      const std::string_view option = k->str();
+      const drivers::OptionSpec* spec = own ? drivers::find_option(own->options, option) : nullptr;
       if (spec == nullptr) {
-        if (const ProtocolInfo* other = kind.owner_of(name, g.name)) {
+        if (const ProtocolInfo* other = kind.owner_of(option, name)) {
           const std::string q(1, kind.owner_quote);
-          fail(*n, key(name), "only for protocol " + q + std::string(other->name) + q + " (this source's protocol is " +
-                                  in_quotes(g.name) + ")");
+          fail(*n, key(option), "only for " + std::string(kind.key) + " " + q + std::string(other->name) + q + " (this " +
+                                    std::string(kind.holder) + "'s " + std::string(kind.key) + " is " + in_quotes(name) + ")");
         }
         continue;
       }
-      out[std::string(name)] = get_option(*n, key(name), *spec);
+      out[std::string(option)] = get_option(*n, key(option), *spec);
       if (g.first_option == nullptr) {
         g.first_option = n;
-        g.first_option_key = key(name);
+        g.first_option_key = key(option);
       }
     }
     return g;
@@ -794,13 +813,23 @@ class Parser {
            "unknown " + std::string(kind.what) + " " + in_quotes(g.name) + " (known: " + (list.empty() ? "none" : list) + ")" +
                suggestion(g.name, names));
     }
+    judge_options(t, prefix, g, g.node, protocol_key, make);
+  }
+
+  // `make` builds the decoder or encoder, which judges its own options. A refusal
+  // (drivers::OptionError) is blamed on the key it names, in the table when given; any other on
+  // the first option given, else on `name_node` (the protocol or encoding key; nullptr: the table).
+  template <class Make>
+  void judge_options(const toml::table& t, const std::string& prefix, const OptionsGiven& g, const toml::node* name_node,
+                     const std::string& name_key, Make make) const {
     try {
-      make();  // the decoder judges its own options
+      make();
     } catch (const drivers::OptionError& e) {
       blame_option(t, prefix, e);
     } catch (const std::invalid_argument& e) {
       if (g.first_option != nullptr) fail(*g.first_option, g.first_option_key, e.what());
-      fail(*g.node, protocol_key, e.what());
+      if (name_node != nullptr) fail(*name_node, name_key, e.what());
+      fail(t.source().begin, name_key, e.what());
     }
   }
 
@@ -1201,15 +1230,21 @@ class Parser {
     const toml::table& t = table_of(node, prefix, "[[output]]");
     auto key = [&](std::string_view name) { return join_key(prefix, name); };
     OutputConfig o;
-    // The encoding first: it may accept keys of its own.
-    if (const toml::node* n = t.get("encoding")) {
-      std::vector<Choice<const OutputEncoder*>> encoders;
-      for (const OutputEncoder* e : output_encoders()) encoders.push_back({e->name(), e});
-      o.encoder = get_choice<const OutputEncoder*>(*n, key("encoding"), encoders);
+    // The encoding first: it may accept keys of its own, which it declares (output_encoder.hpp).
+    const toml::node* encoding_node = t.get("encoding");
+    const OutputEncoderEntry* encoding = output_encoder_entries().front();
+    if (encoding_node != nullptr) {
+      std::vector<Choice<const OutputEncoderEntry*>> encodings;
+      for (const OutputEncoderEntry* e : output_encoder_entries()) encodings.push_back({e->name, e});
+      encoding = get_choice<const OutputEncoderEntry*>(*encoding_node, key("encoding"), encodings);
     }
+    // Every encoding's keys are known here, so that another encoding's is refused as such.
     std::vector<std::string_view> known(std::begin(kOutputKeys), std::end(kOutputKeys));
-    for (std::string_view k : o.encoder->config_keys()) known.push_back(k);
+    for (std::string_view k : output_encodings().all_keys())
+      if (std::find(known.begin(), known.end(), k) == known.end()) known.push_back(k);
     check_keys(t, prefix, known);
+    drivers::OptionMap options;
+    const OptionsGiven given = parse_options(t, prefix, output_encodings(), std::string(encoding->name), options);
 
     const toml::node& dest_node = require(t, "destinations", prefix);
     if (!dest_node.is_array()) wrong_type(dest_node, key("destinations"), "an array of strings");
@@ -1244,6 +1279,8 @@ class Parser {
         o.streams.push_back(id);
       }
     }
+    // Built once, here: the publisher only calls it.
+    judge_options(t, prefix, given, encoding_node, key("encoding"), [&] { o.encoder = encoding->make(options); });
     return o;
   }
 

@@ -543,10 +543,16 @@ class JsonLinesOutputEncoder final : public OutputEncoder {
 
 }  // namespace
 
-// Registered in output_encoder_registry.cpp.
-const OutputEncoder& json_lines_output_encoder() {
-  static const JsonLinesOutputEncoder encoder;
-  return encoder;
+// Registered in output_encoder_registry.cpp. No options: every JSON output shares one encoder.
+const OutputEncoderEntry& json_lines_output_encoding() {
+  static const OutputEncoderEntry entry{
+      "json", "JSON lines: one JSON object per datagram, for scripts and debugging", {},
+      [](const drivers::OptionMap& options) -> std::shared_ptr<const OutputEncoder> {
+        (void)drivers::OptionReader({}, options);  // it reads none: refuses any
+        static const auto encoder = std::make_shared<const JsonLinesOutputEncoder>();
+        return encoder;
+      }};
+  return entry;
 }
 
 }  // namespace posefair::daemon

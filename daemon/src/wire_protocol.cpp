@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include "posefair/daemon/json_lines.hpp"
@@ -182,10 +183,16 @@ class BinaryOutputEncoder final : public OutputEncoder {
 
 }  // namespace
 
-// Registered in output_encoder_registry.cpp.
-const OutputEncoder& binary_output_encoder() {
-  static const BinaryOutputEncoder encoder;
-  return encoder;
+// Registered in output_encoder_registry.cpp. No options: every binary output shares one encoder.
+const OutputEncoderEntry& binary_output_encoding() {
+  static const OutputEncoderEntry entry{
+      "binary", "wire protocol v1: one little-endian binary datagram per pose", {},
+      [](const drivers::OptionMap& options) -> std::shared_ptr<const OutputEncoder> {
+        (void)drivers::OptionReader({}, options);  // it reads none: refuses any
+        static const auto encoder = std::make_shared<const BinaryOutputEncoder>();
+        return encoder;
+      }};
+  return entry;
 }
 
 }  // namespace posefair::daemon

@@ -776,6 +776,27 @@ engine = { cutoff_hz = 10 }
   EXPECT_DOUBLE_EQ(d.streams.at(0).engine.smoothing_t, smoothing_for_cutoff(10.0, 250.0, 2));
 }
 
+TEST(Config, OutputsOfTheSameOptionlessEncodingShareOneEncoder) {
+  // The encoder is built once at load; the publisher encodes each pose once per encoder object.
+  const DaemonConfig c = parse_config(R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[output]]
+destinations = ["127.0.0.1:5700"]
+[[output]]
+encoding = "binary"
+destinations = ["127.0.0.1:5701"]
+[[output]]
+encoding = "json"
+destinations = ["127.0.0.1:5702"]
+)", "/virtual/shared-encoder.toml");
+  ASSERT_EQ(c.outputs.size(), 3u);
+  EXPECT_EQ(c.outputs[0].encoder, c.outputs[1].encoder);
+  EXPECT_EQ(c.outputs[2].encoder->name(), "json");
+  EXPECT_NE(c.outputs[0].encoder, c.outputs[2].encoder);
+}
+
 TEST(Config, TheExampleConfigsLoad) {
   for (const char* name : {"config/minimal.toml", "config/robot.toml", "config/vr-rig.toml", "data/demo/posefaird.toml"}) {
     SCOPED_TRACE(name);
@@ -1004,6 +1025,22 @@ driver = { type = "synthetic" }
 destinations = ["239.255.0.1"]
 ttl = 300
 )", "output[1].ttl: out of range: must be in [0, 255], got 300", 7},
+    {"unknown encoding", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[output]]
+encoding = "jsn"
+destinations = ["127.0.0.1"]
+)", "output[1].encoding: expected one of 'binary', 'json', got 'jsn' (did you mean 'json'?)", 6},
+    {"misspelt output key", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[output]]
+destinations = ["127.0.0.1"]
+ttll = 2
+)", "output[1].ttll: unknown key (did you mean 'ttl'?)", 7},
     {"bad overflow policy", R"([[stream]]
 id = 1
 name = "a"

@@ -8,6 +8,7 @@
 // directory of the config file, so a config and its data can move together.
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -188,7 +189,8 @@ struct StreamConfig {
 };
 
 struct OutputConfig {
-  const OutputEncoder* encoder = output_encoders().front();  // `encoding`: a registered name; default "binary"
+  // `encoding` (a registered name; default "binary") built with its options, once, at load.
+  std::shared_ptr<const OutputEncoder> encoder = default_output_encoder();
   std::vector<Endpoint> destinations;              // unicast and multicast, IPv4 and IPv6; at least one
   SendOptions send;                                // ttl (default 1), interface, loopback
   std::vector<std::uint32_t> streams;              // the streams this output carries; empty = all

@@ -1,16 +1,20 @@
 #pragma once
 // An output encoding: how the publisher turns one pose message into one UDP datagram
 // ([[output]] encoding = "<name>", docs/protocol.md). Each encoding lives with its format (the
-// binary v1 encoder in wire_protocol.cpp, JSON lines in json_lines.cpp) and is registered by
-// one line in output_encoder_registry.cpp. An output's encoder is chosen once, when the config
-// is loaded; the publisher calls it through this interface and knows no encoding by name.
+// binary v1 encoder in wire_protocol.cpp, JSON lines in json_lines.cpp), declares the
+// [[output]] keys it reads in its OutputEncoderEntry (drivers/device_options.hpp, the same
+// convention as the device decoders) and is registered by one line in
+// output_encoder_registry.cpp. An output's encoder is built once, when the config is loaded;
+// the publisher calls it through this interface and knows no encoding by name.
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string_view>
 #include <vector>
 
 #include "posefair/daemon/wire_protocol.hpp"
+#include "posefair/drivers/device_options.hpp"
 
 namespace posefair::daemon {
 
@@ -23,15 +27,27 @@ class OutputEncoder {
   // publisher thread for every pose: an encoding meant for the real-time path must not
   // allocate (binary does not; JSON lines, a convenience, does).
   virtual std::size_t encode(const PoseMessage& m, std::span<std::uint8_t> out) const = 0;
-  // [[output]] keys this encoding accepts beyond the common ones (none for binary and JSON).
-  virtual std::span<const std::string_view> config_keys() const { return {}; }
+};
+
+// An encoding as the registry lists it: its name, one line saying what it writes, the
+// [[output]] keys it accepts beyond the common ones, and the factory, which reads them with
+// drivers::OptionReader and judges them (drivers::OptionError, naming the key, for a bad one).
+// An encoding without options may hand out one shared instance: outputs that share an encoder
+// object share its datagram (the publisher encodes each pose once per encoder).
+struct OutputEncoderEntry {
+  std::string_view name;
+  std::string_view description;
+  std::span<const drivers::OptionSpec> options;
+  std::shared_ptr<const OutputEncoder> (*make)(const drivers::OptionMap& options);
 };
 
 // Every registered encoding, in registration order; the first is the default.
-std::span<const OutputEncoder* const> output_encoders();
+std::span<const OutputEncoderEntry* const> output_encoder_entries();
 // The encoding registered under name, nullptr when none is.
-const OutputEncoder* find_output_encoder(std::string_view name);
+const OutputEncoderEntry* find_output_encoder(std::string_view name);
 // Their names, in registration order (for an error listing them).
 std::vector<std::string_view> output_encoder_names();
+// The default encoding with its default options (an [[output]] without `encoding`).
+std::shared_ptr<const OutputEncoder> default_output_encoder();
 
 }  // namespace posefair::daemon

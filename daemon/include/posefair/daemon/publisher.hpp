@@ -8,6 +8,7 @@
 // it (a full socket buffer is a counted send failure).
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -50,7 +51,7 @@ class Publisher {
   };
   // One per distinct encoder among the outputs: its datagram for the pose being published.
   struct Encoded {
-    const OutputEncoder* encoder = nullptr;
+    std::shared_ptr<const OutputEncoder> encoder;
     std::vector<std::uint8_t> buffer;  // kMaxDatagramSize bytes, allocated once
     std::size_t size = 0;              // 0: not encoded for this pose yet
     bool with_rate = false;            // encoded with the angular velocity

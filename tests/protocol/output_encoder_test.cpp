@@ -1,0 +1,60 @@
+// The output encoding registry (daemon/output_encoder.hpp): every entry builds an encoder of its
+// own name, an encoding without options refuses any with an OptionError naming the key, and
+// hands out one shared encoder (so the publisher encodes each pose once for all its outputs).
+#include "posefair/daemon/output_encoder.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace posefair::daemon {
+namespace {
+
+TEST(OutputEncoderRegistry, EveryEntryBuildsAnEncoderOfItsName) {
+  ASSERT_FALSE(output_encoder_entries().empty());
+  for (const OutputEncoderEntry* e : output_encoder_entries()) {
+    SCOPED_TRACE(std::string(e->name));
+    EXPECT_FALSE(e->description.empty());
+    EXPECT_EQ(find_output_encoder(e->name), e);
+    for (const drivers::OptionSpec& o : e->options) {
+      EXPECT_FALSE(o.name.empty());
+      EXPECT_FALSE(o.doc.empty());
+    }
+    const auto encoder = e->make({});
+    ASSERT_NE(encoder, nullptr);
+    EXPECT_EQ(encoder->name(), e->name);
+  }
+  EXPECT_EQ(find_output_encoder("no-such-encoding"), nullptr);
+}
+
+TEST(OutputEncoderRegistry, BinaryIsTheDefaultAndJsonIsRegistered) {
+  EXPECT_EQ(output_encoder_names(), (std::vector<std::string_view>{"binary", "json"}));
+  EXPECT_EQ(default_output_encoder()->name(), "binary");
+}
+
+TEST(OutputEncoderRegistry, AnEncodingWithoutOptionsRefusesAnyNamingTheKey) {
+  for (const OutputEncoderEntry* e : output_encoder_entries()) {
+    if (!e->options.empty()) continue;
+    SCOPED_TRACE(std::string(e->name));
+    const drivers::OptionMap given{{"zoom", std::int64_t{2}}};
+    try {
+      (void)e->make(given);
+      ADD_FAILURE() << "an undeclared option was accepted";
+    } catch (const drivers::OptionError& error) {
+      EXPECT_EQ(error.key(), "zoom");
+    }
+  }
+}
+
+TEST(OutputEncoderRegistry, AnEncodingWithoutOptionsSharesOneEncoder) {
+  for (const OutputEncoderEntry* e : output_encoder_entries()) {
+    if (!e->options.empty()) continue;
+    SCOPED_TRACE(std::string(e->name));
+    EXPECT_EQ(e->make({}), e->make({}));
+  }
+}
+
+}  // namespace
+}  // namespace posefair::daemon
