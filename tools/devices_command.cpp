@@ -35,8 +35,8 @@ std::string format_registry(std::string_view title, std::span<const Entry* const
   std::string out = "\n" + std::string(title) + ":\n";
   for (const Entry* e : entries) {
     out += "  " + std::string(e->name) + ": " + std::string(e->description) + "\n";
-    for (const drivers::OptionSpec& o : e->options) {
-      out += "    " + std::string(o.name) + " (" + std::string(drivers::to_string(o.type));
+    for (const posefair::OptionSpec& o : e->options) {
+      out += "    " + std::string(o.name) + " (" + std::string(posefair::to_string(o.type));
       if (!o.default_value.empty()) out += ", default " + std::string(o.default_value);
       for (std::size_t c = 0; c < o.choices.size(); ++c) out += (c == 0 ? ", one of " : "|") + std::string(o.choices[c]);
       out += "): " + std::string(o.doc) + "\n";

@@ -25,7 +25,7 @@
 #include "posefair/daemon/wire_protocol.hpp"
 #include "posefair/drivers/can_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
-#include "posefair/drivers/device_options.hpp"
+#include "posefair/core/options.hpp"
 #include "posefair/drivers/hid_report_decoder.hpp"
 #include "posefair/formats/pose_file.hpp"
 
@@ -154,11 +154,11 @@ constexpr std::string_view kSocketCanKeys[] = {"type", "interface", "protocol", 
                                                "reconnect_max"};
 
 // One registry of device protocols (serial, CAN or HID), or the output encodings, as the
-// configuration sees it: names and the options each declares (drivers/device_options.hpp). The
+// configuration sees it: names and the options each declares (core/options.hpp). The
 // wording of its errors is the kind's own, as it always was.
 struct ProtocolInfo {
   std::string_view name;
-  std::span<const drivers::OptionSpec> options;
+  std::span<const posefair::OptionSpec> options;
 };
 struct ProtocolKind {
   std::string_view what;  // "unknown <what> 'x' (known: ...)"
@@ -176,7 +176,7 @@ struct ProtocolKind {
   // The first protocol other than `except` that declares `key`, or nullptr.
   const ProtocolInfo* owner_of(std::string_view key, std::string_view except) const {
     for (const ProtocolInfo& p : protocols)
-      if (p.name != except && drivers::find_option(p.options, key) != nullptr) return &p;
+      if (p.name != except && posefair::find_option(p.options, key) != nullptr) return &p;
     return nullptr;
   }
   std::vector<std::string_view> names() const {
@@ -188,7 +188,7 @@ struct ProtocolKind {
   std::vector<std::string_view> all_keys() const {
     std::vector<std::string_view> keys;
     for (const ProtocolInfo& p : protocols)
-      for (const drivers::OptionSpec& o : p.options)
+      for (const posefair::OptionSpec& o : p.options)
         if (std::find(keys.begin(), keys.end(), o.name) == keys.end()) keys.push_back(o.name);
     return keys;
   }
@@ -720,8 +720,8 @@ class Parser {
   }
 
   // One option value, checked against the TOML type its protocol declares.
-  drivers::OptionValue get_option(const toml::node& n, const std::string& key, const drivers::OptionSpec& spec) const {
-    using drivers::OptionType;
+  posefair::OptionValue get_option(const toml::node& n, const std::string& key, const posefair::OptionSpec& spec) const {
+    using posefair::OptionType;
     switch (spec.type) {
       case OptionType::String:
         if (!spec.choices.empty()) return get_string_choice(n, key, spec.choices);
@@ -749,14 +749,14 @@ class Parser {
         return values;
       }
     }
-    wrong_type(n, key, drivers::to_string(spec.type));
+    wrong_type(n, key, to_string(spec.type));
   }
 
   // The protocol key of a device source (required) and the options of its kind: a key another
   // protocol of the kind declares is refused; each key the protocol declares is type-checked
   // into `out`. The name itself is judged by check_protocol.
   ProtocolGiven parse_protocol_options(const toml::table& t, const std::string& prefix, const ProtocolKind& kind,
-                                       drivers::OptionMap& out) const {
+                                       posefair::OptionMap& out) const {
     ProtocolGiven g;
     g.node = &require(t, "protocol", prefix);
     g.name = get_nonempty_string(*g.node, join_key(prefix, "protocol"));
@@ -768,7 +768,7 @@ class Parser {
   // of the kind declares is refused ("only for protocol 'x'"); each key `name` declares is
   // type-checked into `out`. Other keys are left to check_keys.
   OptionsGiven parse_options(const toml::table& t, const std::string& prefix, const ProtocolKind& kind,
-                             const std::string& name, drivers::OptionMap& out) const {
+                             const std::string& name, posefair::OptionMap& out) const {
     auto key = [&](std::string_view k) { return join_key(prefix, k); };
     OptionsGiven g;
     const ProtocolInfo* own = kind.find(name);
@@ -778,7 +778,7 @@ class Parser {
     std::sort(given.begin(), given.end(), [](const auto& a, const auto& b) { return before(a.first->source().begin, b.first->source().begin); });
     for (const auto& [k, n] : given) {
       const std::string_view option = k->str();
-      const drivers::OptionSpec* spec = own ? drivers::find_option(own->options, option) : nullptr;
+      const posefair::OptionSpec* spec = own ? posefair::find_option(own->options, option) : nullptr;
       if (spec == nullptr) {
         if (const ProtocolInfo* other = kind.owner_of(option, name)) {
           const std::string q(1, kind.owner_quote);
@@ -798,7 +798,7 @@ class Parser {
 
   // A device source's protocol must be one of its kind's ("unknown <what> ..." otherwise, with
   // the list and a suggestion), and its decoder must accept the options: `make` builds it. A
-  // refusal (drivers::OptionError) is blamed on the key it names, in the table when given;
+  // refusal (posefair::OptionError) is blamed on the key it names, in the table when given;
   // any other on the first option given, else on the protocol.
   template <class Make>
   void check_protocol(const toml::table& t, const std::string& prefix, const ProtocolKind& kind, const ProtocolGiven& g,
@@ -817,14 +817,14 @@ class Parser {
   }
 
   // `make` builds the decoder or encoder, which judges its own options. A refusal
-  // (drivers::OptionError) is blamed on the key it names, in the table when given; any other on
+  // (posefair::OptionError) is blamed on the key it names, in the table when given; any other on
   // the first option given, else on `name_node` (the protocol or encoding key; nullptr: the table).
   template <class Make>
   void judge_options(const toml::table& t, const std::string& prefix, const OptionsGiven& g, const toml::node* name_node,
                      const std::string& name_key, Make make) const {
     try {
       make();
-    } catch (const drivers::OptionError& e) {
+    } catch (const posefair::OptionError& e) {
       blame_option(t, prefix, e);
     } catch (const std::invalid_argument& e) {
       if (g.first_option != nullptr) fail(*g.first_option, g.first_option_key, e.what());
@@ -835,7 +835,7 @@ class Parser {
 
   // Reports a decoder's refusal at the key it names: "name" or "name[n]" (an array element,
   // 1-based); a key not in the table (a default judged against a given one) at the table.
-  [[noreturn]] void blame_option(const toml::table& t, const std::string& prefix, const drivers::OptionError& e) const {
+  [[noreturn]] void blame_option(const toml::table& t, const std::string& prefix, const posefair::OptionError& e) const {
     std::string name = e.key();
     std::size_t index = 0;
     if (const std::size_t open = name.find('['); open != std::string::npos) {
@@ -1027,7 +1027,7 @@ class Parser {
                                      : nullptr;
       if (info != nullptr) {
         candidates.assign(own->own_keys.begin(), own->own_keys.end());
-        for (const drivers::OptionSpec& o : info->options) candidates.push_back(o.name);
+        for (const posefair::OptionSpec& o : info->options) candidates.push_back(o.name);
       }
       fail(first->source().begin, key, unknown + suggestion(first->str(), candidates));
     }
@@ -1243,7 +1243,7 @@ class Parser {
     for (std::string_view k : output_encodings().all_keys())
       if (std::find(known.begin(), known.end(), k) == known.end()) known.push_back(k);
     check_keys(t, prefix, known);
-    drivers::OptionMap options;
+    posefair::OptionMap options;
     const OptionsGiven given = parse_options(t, prefix, output_encodings(), std::string(encoding->name), options);
 
     const toml::node& dest_node = require(t, "destinations", prefix);

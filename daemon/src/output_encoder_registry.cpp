@@ -2,7 +2,7 @@
 // function that returns the encoding's entry, defined in the encoding's own file.
 #include "posefair/daemon/output_encoder.hpp"
 
-#include "posefair/drivers/registry_lookup.hpp"
+#include "posefair/core/registry_lookup.hpp"
 
 namespace posefair::daemon {
 
@@ -18,7 +18,7 @@ std::span<const OutputEncoderEntry* const> output_encoder_entries() {
 }
 
 const OutputEncoderEntry* find_output_encoder(std::string_view name) {
-  return drivers::find_entry(output_encoder_entries(), name);
+  return posefair::find_entry(output_encoder_entries(), name);
 }
 
 std::vector<std::string_view> output_encoder_names() {

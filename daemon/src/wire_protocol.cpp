@@ -187,8 +187,8 @@ class BinaryOutputEncoder final : public OutputEncoder {
 const OutputEncoderEntry& binary_output_encoding() {
   static const OutputEncoderEntry entry{
       "binary", "wire protocol v1: one little-endian binary datagram per pose", {},
-      [](const drivers::OptionMap& options) -> std::shared_ptr<const OutputEncoder> {
-        (void)drivers::OptionReader({}, options);  // it reads none: refuses any
+      [](const posefair::OptionMap& options) -> std::shared_ptr<const OutputEncoder> {
+        (void)posefair::OptionReader({}, options);  // it reads none: refuses any
         static const auto encoder = std::make_shared<const BinaryOutputEncoder>();
         return encoder;
       }};

@@ -7,7 +7,7 @@
 #include "posefair/drivers/can_decoder.hpp"
 #include "posefair/drivers/dronecan_ahrs_decoder.hpp"
 #include "posefair/drivers/posefair_can_decoder.hpp"
-#include "posefair/drivers/registry_lookup.hpp"
+#include "posefair/core/registry_lookup.hpp"
 #include "posefair/drivers/xsens_can_decoder.hpp"
 
 namespace posefair::drivers {

@@ -4,7 +4,7 @@
 #include "posefair/drivers/bno08x_rvc_decoder.hpp"
 #include "posefair/drivers/decoder.hpp"
 #include "posefair/drivers/posefair_serial_decoder.hpp"
-#include "posefair/drivers/registry_lookup.hpp"
+#include "posefair/core/registry_lookup.hpp"
 #include "posefair/drivers/vectornav_decoder.hpp"
 #include "posefair/drivers/witmotion_decoder.hpp"
 #include "posefair/drivers/xsens_decoder.hpp"

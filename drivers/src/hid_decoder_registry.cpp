@@ -5,7 +5,7 @@
 #include "posefair/drivers/hid_report_decoder.hpp"
 #include "posefair/drivers/hid_sensor_orientation_decoder.hpp"
 #include "posefair/drivers/hid_vendor_layout_decoder.hpp"
-#include "posefair/drivers/registry_lookup.hpp"
+#include "posefair/core/registry_lookup.hpp"
 
 namespace posefair::drivers {
 namespace {

@@ -27,7 +27,7 @@ using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
 // A decoder option as the configuration handed it on (text options arrive as text).
-std::string option_text(const drivers::OptionMap& options, const std::string& key) {
+std::string option_text(const posefair::OptionMap& options, const std::string& key) {
   const auto it = options.find(key);
   return it == options.end() ? std::string("(absent)") : std::get<std::string>(it->second);
 }

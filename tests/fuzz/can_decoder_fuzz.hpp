@@ -18,9 +18,9 @@
 
 namespace posefair::testing {
 
-using MakeCanDecoder = std::unique_ptr<drivers::CanDecoder> (*)(const drivers::OptionMap&);
+using MakeCanDecoder = std::unique_ptr<drivers::CanDecoder> (*)(const posefair::OptionMap&);
 
-inline CanDecoded fuzz_can_decoder(MakeCanDecoder make, const drivers::OptionMap& options,
+inline CanDecoded fuzz_can_decoder(MakeCanDecoder make, const posefair::OptionMap& options,
                                    std::span<const std::uint8_t> data, std::span<const std::uint32_t> ids,
                                    std::uint32_t foreign_id) {
   const std::vector<drivers::CanFrame> frames = frames_from_bytes(data, ids);

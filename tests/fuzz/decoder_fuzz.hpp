@@ -15,12 +15,12 @@
 
 namespace posefair::testing {
 
-using MakeDecoder = std::unique_ptr<drivers::Decoder> (*)(const drivers::OptionMap&);
+using MakeDecoder = std::unique_ptr<drivers::Decoder> (*)(const posefair::OptionMap&);
 
 // Decodes `data` whole, then once cut at each list of offsets (increasing, each at most
 // data.size()) with a fresh decoder each time; aborts unless every run gives what the whole
 // one gave. Returns the whole run.
-inline Decoded fuzz_decoder(MakeDecoder make, const drivers::OptionMap& options, std::span<const std::uint8_t> data,
+inline Decoded fuzz_decoder(MakeDecoder make, const posefair::OptionMap& options, std::span<const std::uint8_t> data,
                             std::initializer_list<std::initializer_list<std::size_t>> cuts) {
   Decoded whole = decode_chunks(make(options), data);
   if (whole.counters.bytes != data.size() || whole.counters.samples != whole.samples.size()) std::abort();

@@ -16,7 +16,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::size_t a = static_cast<std::size_t>(h % (size + 1));
   const std::size_t b = static_cast<std::size_t>((h >> 32) % (size + 1));
   for (const char* mode : {"reject", "accept"}) {
-    const posefair::drivers::OptionMap options{{"vectornav_unchecked", std::string(mode)}};
+    const posefair::OptionMap options{{"vectornav_unchecked", std::string(mode)}};
     const auto whole = posefair::testing::fuzz_decoder(posefair::drivers::make_vectornav_decoder, options, {data, size},
                                                        {{a}, {std::min(a, b), std::max(a, b)}});
     for (const auto& s : whole.samples)

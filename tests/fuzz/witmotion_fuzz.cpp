@@ -10,7 +10,7 @@
 #include "posefair/drivers/witmotion_decoder.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  const posefair::drivers::OptionMap options{
+  const posefair::OptionMap options{
       {"witmotion_scalar", std::string((size > 0 && (data[size - 1] & 1)) ? "last" : "first")}};
   std::size_t cut = 0;
   for (std::size_t i = 0; i < size && i < 8; ++i) cut = cut * 131 + data[size - 1 - i];

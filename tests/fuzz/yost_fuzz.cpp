@@ -18,7 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::size_t a = static_cast<std::size_t>(h % (size + 1));
   const std::size_t b = static_cast<std::size_t>((h >> 32) % (size + 1));
   for (const auto& [header, length] : {std::pair{"0x4F", "16"}, std::pair{"0x7F", "20"}}) {
-    const posefair::drivers::OptionMap options{{"yost_header", std::string(header)}, {"yost_data_length", std::string(length)}};
+    const posefair::OptionMap options{{"yost_header", std::string(header)}, {"yost_data_length", std::string(length)}};
     const auto whole = posefair::testing::fuzz_decoder(posefair::drivers::make_yost_decoder, options, {data, size},
                                                        {{a}, {std::min(a, b), std::max(a, b)}});
     for (const auto& s : whole.samples)

@@ -18,7 +18,7 @@ TEST(OutputEncoderRegistry, EveryEntryBuildsAnEncoderOfItsName) {
     SCOPED_TRACE(std::string(e->name));
     EXPECT_FALSE(e->description.empty());
     EXPECT_EQ(find_output_encoder(e->name), e);
-    for (const drivers::OptionSpec& o : e->options) {
+    for (const posefair::OptionSpec& o : e->options) {
       EXPECT_FALSE(o.name.empty());
       EXPECT_FALSE(o.doc.empty());
     }
@@ -38,11 +38,11 @@ TEST(OutputEncoderRegistry, AnEncodingWithoutOptionsRefusesAnyNamingTheKey) {
   for (const OutputEncoderEntry* e : output_encoder_entries()) {
     if (!e->options.empty()) continue;
     SCOPED_TRACE(std::string(e->name));
-    const drivers::OptionMap given{{"zoom", std::int64_t{2}}};
+    const posefair::OptionMap given{{"zoom", std::int64_t{2}}};
     try {
       (void)e->make(given);
       ADD_FAILURE() << "an undeclared option was accepted";
-    } catch (const drivers::OptionError& error) {
+    } catch (const posefair::OptionError& error) {
       EXPECT_EQ(error.key(), "zoom");
     }
   }

@@ -79,7 +79,7 @@ struct DaemonSettings {
 struct SocketCanSourceConfig {
   std::string interface;              // e.g. "can0"; for a candump replay empty = every interface
   std::string protocol;               // one of drivers::can_decoder_protocols()
-  drivers::OptionMap decoder;         // the options given that the protocol declares
+  posefair::OptionMap decoder;         // the options given that the protocol declares
   bool fd = false;                    // also receive CAN FD frames
   drivers::TimeSource time_source = drivers::TimeSource::Auto;
   double reconnect_min = 0.1;         // s
@@ -117,7 +117,7 @@ struct SerialSourceConfig {
   drivers::SerialPortSpec port;       // device (absolute path) or usb (+ serial_number)
   drivers::SerialSettings settings;   // baud, data_bits, parity, stop_bits, flow_control
   std::string protocol;               // one of drivers::decoder_protocols()
-  drivers::OptionMap decoder;         // the options given that the protocol declares
+  posefair::OptionMap decoder;         // the options given that the protocol declares
   drivers::TimeSource time_source = drivers::TimeSource::Auto;
   double reconnect_min = 0.1;         // s
   double reconnect_max = 5.0;         // s, >= reconnect_min
@@ -129,7 +129,7 @@ struct SerialSourceConfig {
 struct HidSourceConfig {
   drivers::HidDeviceSpec device;                 // device (absolute path) or usb (+ serial_number)
   std::string protocol;                          // one of drivers::hid_decoder_protocols()
-  drivers::OptionMap decoder;                    // the options given that the protocol declares
+  posefair::OptionMap decoder;                    // the options given that the protocol declares
   drivers::TimeSource time_source = drivers::TimeSource::Auto;
   double reconnect_min = 0.1;                    // s
   double reconnect_max = 5.0;                    // s, >= reconnect_min

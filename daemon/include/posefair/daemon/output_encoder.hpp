@@ -2,7 +2,7 @@
 // An output encoding: how the publisher turns one pose message into one UDP datagram
 // ([[output]] encoding = "<name>", docs/protocol.md). Each encoding lives with its format (the
 // binary v1 encoder in wire_protocol.cpp, JSON lines in json_lines.cpp), declares the
-// [[output]] keys it reads in its OutputEncoderEntry (drivers/device_options.hpp, the same
+// [[output]] keys it reads in its OutputEncoderEntry (core/options.hpp, the same
 // convention as the device decoders) and is registered by one line in
 // output_encoder_registry.cpp. An output's encoder is built once, when the config is loaded;
 // the publisher calls it through this interface and knows no encoding by name.
@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "posefair/daemon/wire_protocol.hpp"
-#include "posefair/drivers/device_options.hpp"
+#include "posefair/core/options.hpp"
 
 namespace posefair::daemon {
 
@@ -31,14 +31,14 @@ class OutputEncoder {
 
 // An encoding as the registry lists it: its name, one line saying what it writes, the
 // [[output]] keys it accepts beyond the common ones, and the factory, which reads them with
-// drivers::OptionReader and judges them (drivers::OptionError, naming the key, for a bad one).
+// posefair::OptionReader and judges them (posefair::OptionError, naming the key, for a bad one).
 // An encoding without options may hand out one shared instance: outputs that share an encoder
 // object share its datagram (the publisher encodes each pose once per encoder).
 struct OutputEncoderEntry {
   std::string_view name;
   std::string_view description;
-  std::span<const drivers::OptionSpec> options;
-  std::shared_ptr<const OutputEncoder> (*make)(const drivers::OptionMap& options);
+  std::span<const posefair::OptionSpec> options;
+  std::shared_ptr<const OutputEncoder> (*make)(const posefair::OptionMap& options);
 };
 
 // Every registered encoding, in registration order; the first is the default.

@@ -7,7 +7,7 @@
 // comes with the frame), no allocation after construction, never throws on any frame.
 //
 // One file per protocol in drivers/src/, opening with a comment that names its reference
-// document and quirks and declaring the options it reads (device_options.hpp) in its
+// document and quirks and declaring the options it reads (core/options.hpp) in its
 // CanDecoderEntry; can_decoder_registry.cpp lists the entries (one line per protocol).
 //
 // Counters. DecoderCounters keeps its meaning per valid protocol message:

@@ -7,7 +7,7 @@
 // Every decoder resynchronises after garbage (it searches for the next frame start), verifies
 // the frame's checksum before using a byte of it, and counts what it saw. One file per
 // protocol in drivers/src/, opening with a comment that names the reference document and the
-// device's quirks and declaring the options it reads (device_options.hpp) in its DecoderEntry;
+// device's quirks and declaring the options it reads (core/options.hpp) in its DecoderEntry;
 // decoder_registry.cpp lists the entries (one line per protocol).
 #include <cstdint>
 #include <memory>
@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "posefair/core/sample.hpp"
-#include "posefair/drivers/device_options.hpp"
+#include "posefair/core/options.hpp"
 
 namespace posefair::drivers {
 

@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "posefair/drivers/decoder.hpp"
-#include "posefair/drivers/device_options.hpp"
+#include "posefair/core/options.hpp"
 
 namespace posefair::drivers {
 

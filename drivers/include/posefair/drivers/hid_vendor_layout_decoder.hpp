@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "posefair/core/sample.hpp"
-#include "posefair/drivers/device_options.hpp"
+#include "posefair/core/options.hpp"
 #include "posefair/drivers/hid_report_decoder.hpp"
 
 namespace posefair::drivers {

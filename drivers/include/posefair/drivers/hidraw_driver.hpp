@@ -27,7 +27,7 @@
 
 #include "posefair/drivers/device_link_driver.hpp"
 #include "posefair/drivers/hid_report_decoder.hpp"
-#include "posefair/drivers/device_options.hpp"
+#include "posefair/core/options.hpp"
 #include "posefair/drivers/usb_id.hpp"
 
 namespace posefair::drivers {

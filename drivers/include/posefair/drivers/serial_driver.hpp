@@ -31,7 +31,7 @@ struct SerialDriverOptions : DeviceLinkOptions {
   SerialPortSpec port;
   SerialSettings settings;
   std::string protocol;                // decoder registry name (decoder.hpp), used when `decoder` is null
-  OptionMap decoder_options;           // its options (decoder.hpp, device_options.hpp)
+  OptionMap decoder_options;           // its options (decoder.hpp, core/options.hpp)
   std::unique_ptr<Decoder> decoder;    // an injected decoder (tests); takes the place of `protocol`
   std::size_t read_buffer = 4096;      // bytes per read, > 0
 };

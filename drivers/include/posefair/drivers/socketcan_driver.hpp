@@ -45,7 +45,7 @@ namespace posefair::drivers {
 struct SocketCanDriverOptions : DeviceLinkOptions {
   std::string interface;               // e.g. "can0"; at most 15 characters (IFNAMSIZ − 1)
   std::string protocol;                // CAN decoder registry name, used when `decoder` is null
-  OptionMap decoder_options;           // its options (can_decoder.hpp, device_options.hpp)
+  OptionMap decoder_options;           // its options (can_decoder.hpp, core/options.hpp)
   std::unique_ptr<CanDecoder> decoder; // an injected decoder (tests); takes the place of `protocol`
   bool fd = false;                     // also receive CAN FD frames (CAN_RAW_FD_FRAMES)
 };

@@ -1,10 +1,10 @@
 #pragma once
-// The options of a device protocol decoder (serial, CAN or HID): each decoder declares the keys
-// it reads (OptionSpec: name, TOML value type, default, one line of doc) in its own file, and its
-// registry entry carries that list. The configuration hands a decoder only a small map of the
-// values it was given (OptionMap); the decoder reads them with OptionReader and judges them
-// itself, throwing OptionError, which names the key, so the configuration can point at it.
-// Nothing outside a decoder's file knows its keys by name.
+// The options of a registered item (a device protocol decoder, an output encoding): each declares
+// the keys it reads (OptionSpec: name, TOML value type, default, one line of doc) in its own
+// file, and its registry entry carries that list. The configuration hands it only a small map of
+// the values it was given (OptionMap); it reads them with OptionReader and judges them itself,
+// throwing OptionError, which names the key, so the configuration can point at it. Nothing
+// outside the item's file knows its keys by name. Pure types: no I/O, so they live in core.
 #include <cstdint>
 #include <initializer_list>
 #include <map>
@@ -15,7 +15,7 @@
 #include <variant>
 #include <vector>
 
-namespace posefair::drivers {
+namespace posefair {
 
 // The TOML type a key takes.
 enum class OptionType {
@@ -90,4 +90,4 @@ class OptionReader {
 // The spec named `key` in `specs`, or nullptr.
 const OptionSpec* find_option(std::span<const OptionSpec> specs, std::string_view key);
 
-}  // namespace posefair::drivers
+}  // namespace posefair

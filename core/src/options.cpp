@@ -1,12 +1,12 @@
-// Reading a decoder's declared options; see device_options.hpp.
-#include "posefair/drivers/device_options.hpp"
+// Reading declared options; see options.hpp.
+#include "posefair/core/options.hpp"
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
 
-namespace posefair::drivers {
+namespace posefair {
 
 std::string_view to_string(OptionType type) {
   switch (type) {
@@ -126,4 +126,4 @@ std::vector<std::int64_t> OptionReader::integers(std::string_view key) const {
   throw OptionError(std::string(key), "missing required key");
 }
 
-}  // namespace posefair::drivers
+}  // namespace posefair

@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-namespace posefair::drivers {
+namespace posefair {
 
 // The entry registered under name, nullptr when none is.
 template <class Entry>
@@ -27,4 +27,4 @@ std::vector<std::string> entry_names(std::span<const Entry* const> table) {
   return names;
 }
 
-}  // namespace posefair::drivers
+}  // namespace posefair
