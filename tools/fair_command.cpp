@@ -39,7 +39,7 @@ struct FairOptions {
   // --causal: the real-time engine over the file.
   bool causal = false;
   WindowConfig window;
-  std::optional<double> cutoff_hz;      // sets window.smoothing_r/t from the file's rate
+  std::optional<int> order;             // batch: the paper's 3; causal: the engine's default (2)
   std::optional<double> smoothing;      // μ for both rotation and position
   std::optional<int> window_iterations;
 };
@@ -75,21 +75,15 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
   WindowConfig c = o.window;
   c.epsilon_r = o.eps_r_rotation / 2.0;
   c.epsilon_t = o.params.epsilon_t;
-  c.order = o.params.order;
+  c.order = o.order.value_or(c.order);
   c.lambda_r = o.params.lambda_r;
   c.lambda_t = o.params.lambda_t;
   c.variant = o.params.variant;
   if (o.window_iterations) c.iterations = *o.window_iterations;
   const double rate = median_sample_rate(in.time);
+  // A whole file is at hand: its median rate serves where a live stream would measure its first intervals.
+  if (c.rate_hz == 0.0) c.rate_hz = rate;
   if (o.smoothing) c.smoothing_r = c.smoothing_t = *o.smoothing;
-  if (o.cutoff_hz) {
-    try {
-      c.smoothing_r = c.smoothing_t = smoothing_for_cutoff(*o.cutoff_hz, rate, c.order);
-    } catch (const std::invalid_argument& e) {
-      std::cerr << "posefair fair: --cutoff " << *o.cutoff_hz << " Hz at the file's " << rate << " Hz: " << e.what() << "\n";
-      return exit_code(ErrorKind::Usage);
-    }
-  }
   try {
     validate(c);
   } catch (const std::invalid_argument& e) {
@@ -103,9 +97,20 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
   if (!o.quiet) {
     const char* solver = c.solver == WindowSolver::Linear ? "linear" : c.solver == WindowSolver::GaussNewton ? "gauss-newton" : "sweeps";
     print_input_line(o, file, "median", rate);
-    std::printf("causal   m=%d, %s solver, window %d, lag %d (%.3g ms), iterations %d, mu_r %.6g, continuity %g, bound per %s\n",
-                c.order, solver, c.window, c.lag, rate > 0 ? 1000.0 * c.lag / rate : 0.0, c.iterations, c.smoothing_r,
-                c.continuity, c.bound == BoundPolicy::Sample ? "sample" : "window");
+    const EngineState st = r.state;
+    std::printf("causal   m=%d, %s solver, window %d (%.3g s at %.4g Hz), lag %d (%.3g ms), horizon %.3g ms, continuity %g, bound per %s\n",
+                c.order, solver, st.window, st.rate_hz > 0 ? st.window / st.rate_hz : 0.0, st.rate_hz, c.lag,
+                st.rate_hz > 0 ? 1000.0 * c.lag / st.rate_hz : 0.0, 1e3 * c.horizon_s, c.continuity,
+                c.bound == BoundPolicy::Sample ? "sample" : "window");
+    auto channel = [&](const char* name, const ChannelAdaptation& a, const char* unit) {
+      if (a.adaptive)
+        std::printf("%s adapted: noise %.3g %s, motion %.3g %s/s^%d, mu %.4g (cutoff %.3g Hz) at the end\n", name, a.noise, unit,
+                    a.motion, unit, c.order, a.smoothing, a.cutoff_hz);
+      else
+        std::printf("%s fixed: mu %.6g (cutoff %.3g Hz)\n", name, a.smoothing, a.cutoff_hz);
+    };
+    channel("rotation", st.rotation, "rad");
+    if (in.has_position()) channel("position", st.position, "units");
     std::printf("samples  %llu emitted, %llu clamped to the bound, %llu restarts after gaps, %llu dropped, %llu rejected\n",
                 static_cast<unsigned long long>(r.counters.emitted), static_cast<unsigned long long>(r.counters.clamped),
                 static_cast<unsigned long long>(r.counters.restarts), static_cast<unsigned long long>(r.gate.dropped()),
@@ -131,6 +136,7 @@ int run_fair(FairOptions o) {
   ro.skip_missing = o.skip_missing;
   // The user's bound is a physical rotation angle; the paper's eq. 20 bounds dist on S³ (half).
   o.params.epsilon_r = o.eps_r_rotation / 2.0;
+  if (o.order) o.params.order = *o.order;
 
   std::optional<formats::PoseFile> read;
   try {
@@ -184,9 +190,10 @@ void add_fair_command(CLI::App& app, int& exit_code) {
       ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case));
   cmd->add_option("--joint", o->joint, "BVH: the joint to fair");
   cmd->add_flag("--skip-missing", o->skip_missing, "CSV: drop rows whose quaternion is nan or empty");
-  cmd->add_option("-m,--order", o->params.order, "fairing order m (2: constant angular velocity, 3: constant acceleration)")
-      ->check(CLI::IsMember({2, 3}))
-      ->capture_default_str();
+  cmd->add_option("-m,--order", o->order,
+                  "fairing order m (2: constant angular velocity, 3: constant acceleration); default 3 for batch fairing (the "
+                  "paper's), 2 with --causal (the engine's)")
+      ->check(CLI::IsMember({2, 3}));
   cmd->add_option("--lambda-r", o->params.lambda_r, "rotational damping (slerp factor) in (0, 1]")
       ->check(CLI::Range(1e-9, 1.0))
       ->capture_default_str();
@@ -212,7 +219,19 @@ void add_fair_command(CLI::App& app, int& exit_code) {
 
   // The real-time engine, run over the file exactly as the daemon runs it (docs/engine.md).
   auto* causal = cmd->add_flag("--causal", o->causal, "run the real-time sliding-window engine instead of batch fairing");
-  cmd->add_option("--window", o->window.window, "causal: window length W (samples)")->capture_default_str()->needs(causal);
+  cmd->add_option("--window", o->window.window, "causal: window length W in samples (default: --window-time at the stream's rate)")
+      ->check(CLI::Range(0, 4096))
+      ->needs(causal);
+  cmd->add_option("--window-time", o->window.window_s, "causal: the window as a time span, seconds")
+      ->check(CLI::Range(1e-6, 60.0))
+      ->capture_default_str()
+      ->needs(causal);
+  cmd->add_option("--rate", o->window.rate_hz, "causal: the stream's rate in Hz (default: the file's median rate)")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(causal);
+  cmd->add_option("--horizon", o->window.horizon_s, "causal: emit the pose predicted this many seconds past each sample (VR prediction)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->needs(causal);
   cmd->add_option("--lag", o->window.lag, "causal: output lag L (samples; 0 = no added delay)")->capture_default_str()->needs(causal);
   const std::map<std::string, WindowSolver> solvers{{"linear", WindowSolver::Linear},
                                                     {"gauss-newton", WindowSolver::GaussNewton},
@@ -223,10 +242,11 @@ void add_fair_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--window-iterations", o->window_iterations, "causal: Gauss-Newton iterations or damped sweeps per sample (default 1)")
       ->check(CLI::Range(0, 1000))
       ->needs(causal);
-  auto* smoothing = cmd->add_option("--smoothing", o->smoothing, "causal: smoothing weight mu of E_m against the data term")
+  auto* smoothing = cmd->add_option("--smoothing", o->smoothing,
+                                    "causal: fixed smoothing weight mu of E_m against the data term (default: adapted to the stream)")
                         ->check(CLI::NonNegativeNumber)
                         ->needs(causal);
-  cmd->add_option("--cutoff", o->cutoff_hz, "causal: set mu for this half-power frequency (Hz) at the file's rate")
+  cmd->add_option("--cutoff", o->window.cutoff_hz, "causal: fixed smoothing: mu for this half-gain frequency (Hz) at the stream's rate")
       ->check(CLI::PositiveNumber)
       ->excludes(smoothing)
       ->needs(causal);

@@ -40,23 +40,32 @@ void BandedCholesky::solve(std::span<Vec3> x) const {
   }
 }
 
-BandedCholesky make_smoothing_system(int n, int m, double mu, std::span<const double> diagonal) {
-  BandedCholesky a(n, m);
+void BandedCholesky::reshape(int n) {
+  n_ = n;
+  std::fill(band_.begin(), band_.begin() + static_cast<std::ptrdiff_t>(n * (b_ + 1)), 0.0);
+}
+
+bool assemble_smoothing_system(BandedCholesky& a, int n, int m, double mu, std::span<const double> diagonal) {
+  a.reshape(n);
   for (int i = 0; i < n; ++i) a.at(i, i) = diagonal[static_cast<std::size_t>(i)];
   if (n > m && mu > 0.0) {
-    // Stencil of D^m: (-1)^(m-k) C(m, k), k = 0..m.
-    std::vector<double> c(static_cast<std::size_t>(m + 1));
-    for (int k = 0; k <= m; ++k) {
+    // Stencil of D^m: (-1)^(m-k) C(m, k), k = 0..m (m ≤ 3 here; at most 8 entries in any case).
+    double c[9] = {};
+    for (int k = 0; k <= m && k < 9; ++k) {
       double binom = 1.0;
       for (int j = 1; j <= k; ++j) binom = binom * (m - j + 1) / j;
-      c[static_cast<std::size_t>(k)] = ((m - k) % 2 == 0 ? 1.0 : -1.0) * binom;
+      c[k] = ((m - k) % 2 == 0 ? 1.0 : -1.0) * binom;
     }
     for (int row = 0; row + m < n; ++row)
       for (int k = 0; k <= m; ++k)
-        for (int l = 0; l <= k; ++l)
-          a.at(row + k, row + l) += mu * c[static_cast<std::size_t>(k)] * c[static_cast<std::size_t>(l)];
+        for (int l = 0; l <= k; ++l) a.at(row + k, row + l) += mu * c[k] * c[l];
   }
-  if (!a.factor()) throw std::invalid_argument("smoothing system is not positive definite");
+  return a.factor();
+}
+
+BandedCholesky make_smoothing_system(int n, int m, double mu, std::span<const double> diagonal) {
+  BandedCholesky a(n, m);
+  if (!assemble_smoothing_system(a, n, m, mu, diagonal)) throw std::invalid_argument("smoothing system is not positive definite");
   return a;
 }
 

@@ -19,6 +19,7 @@ CausalResult fair_causal(const PoseSequence& input, const WindowConfig& config) 
       // Each output keeps the sign its input sample had, as the batch tool does.
       r.poses.orientation[i] = so3::aligned_to(f.orientation, input.orientation[i]);
       if (with_p) r.poses.position[i] = f.position;
+      r.poses.time[i] = f.time;  // later than the input's with a horizon: the time it predicts
       r.emitted[i] = true;
       r.max_dist_r = std::max(r.max_dist_r, so3::dist(f.orientation, input.orientation[i]));
       if (with_p) r.max_deviation_t = std::max(r.max_deviation_t, (f.position - input.position[i]).norm());
@@ -38,6 +39,7 @@ CausalResult fair_causal(const PoseSequence& input, const WindowConfig& config) 
   take(window.flush(out));
   r.counters = window.counters();
   r.gate = window.gate_counters();
+  r.state = window.state();
   return r;
 }
 

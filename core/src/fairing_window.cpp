@@ -62,33 +62,86 @@ void difference_adjoint(std::span<Vec3> v, int len) {
   }
 }
 
+enum class SmoothingSource { Given, Cutoff, Adaptive };
+
+SmoothingSource smoothing_source(const WindowConfig& c, bool rotation) {
+  if (rotation ? c.smoothing_r.has_value() : c.smoothing_t.has_value()) return SmoothingSource::Given;
+  if (c.cutoff_hz) return SmoothingSource::Cutoff;
+  return SmoothingSource::Adaptive;
+}
+
+// The fixed μ of a channel at this rate (a cutoff needs the rate; one at or above half the
+// rate, possible only with a measured rate, is held just below it).
+double fixed_smoothing(const WindowConfig& c, bool rotation, double rate) {
+  const std::optional<double>& given = rotation ? c.smoothing_r : c.smoothing_t;
+  if (given) return *given;
+  return smoothing_for_cutoff(std::min(*c.cutoff_hz, 0.45 * rate), rate, c.order);
+}
+
+// Whether a channel's smoothing is known without the stream's rate.
+bool resolvable(const WindowConfig& c, bool rotation) {
+  const SmoothingSource s = smoothing_source(c, rotation);
+  return s == SmoothingSource::Given || (s == SmoothingSource::Cutoff && c.rate_hz > 0.0);
+}
+
 }  // namespace
 
 void validate(const WindowConfig& c) {
   using S = EngineSetting;
   auto bad = [](EngineSetting setting, const std::string& what) { throw InvalidEngineSetting(setting, what); };
   if (c.order != 2 && c.order != 3) bad(S::Order, "order must be 2 or 3, got " + std::to_string(c.order));
-  if (c.window < c.order + 1 || c.window > 4096)
+  if (c.window != 0 && (c.window < c.order + 1 || c.window > 4096))
     bad(S::Window, "window must hold " + std::to_string(c.order + 1) + " to 4096 samples for order " +
                        std::to_string(c.order) + ", got " + std::to_string(c.window));
-  if (c.lag < 0 || c.lag >= c.window)
+  if (!(c.window_s > 0.0 && c.window_s <= 60.0)) bad(S::Window, "window_s must be in (0, 60] seconds, got " + std::to_string(c.window_s));
+  if (c.max_window < kMinWindowSamples || c.max_window > 4096)
+    bad(S::Window, "max_window must be in [" + std::to_string(kMinWindowSamples) + ", 4096], got " + std::to_string(c.max_window));
+  if (c.window > 0 && (c.lag < 0 || c.lag >= c.window))
     bad(S::Lag, "lag must be in [0, window-1] = [0, " + std::to_string(c.window - 1) + "], got " + std::to_string(c.lag));
+  if (c.window == 0 && (c.lag < 0 || c.lag > c.max_window - 2))
+    bad(S::Lag, "lag must be in [0, max_window-2] = [0, " + std::to_string(c.max_window - 2) + "], got " + std::to_string(c.lag));
+  if (!(c.horizon_s >= 0.0 && c.horizon_s <= 1.0)) bad(S::Horizon, "horizon must be in [0, 1] seconds, got " + std::to_string(c.horizon_s));
+  if (c.horizon_s > 0.0) {
+    if (c.lag != 0) bad(S::Horizon, "a horizon (prediction) needs lag 0");
+    if (c.solver != WindowSolver::Linear) bad(S::Horizon, "a horizon (prediction) needs the linear solver");
+    if (c.continuity > 0.0) bad(S::Horizon, "a horizon (prediction) cannot be combined with continuity");
+    if (std::isfinite(c.epsilon_r) || std::isfinite(c.epsilon_t))
+      bad(S::Horizon, "a horizon (prediction) cannot be combined with an epsilon bound: a predicted pose has no measurement to be bounded by");
+  }
   if (c.iterations < 0 || c.iterations > 1000)
     bad(S::Iterations, "iterations must be in [0, 1000], got " + std::to_string(c.iterations));
   if (c.iterations == 0 && c.solver == WindowSolver::GaussNewton)
     bad(S::Iterations, "iterations must be at least 1 for the gauss-newton solver (0 would emit the warm-start extrapolation)");
   // Beyond about 1e10 the window is already an exact polynomial fit and the system only loses
   // precision (I + μDᵀD becomes numerically singular).
-  if (!(c.smoothing_r >= 0.0 && c.smoothing_r <= kMaxSmoothing))
-    bad(S::SmoothingR, "smoothing_r must be in [0, 1e10], got " + std::to_string(c.smoothing_r));
-  if (!(c.smoothing_t >= 0.0 && c.smoothing_t <= kMaxSmoothing))
-    bad(S::SmoothingT, "smoothing_t must be in [0, 1e10], got " + std::to_string(c.smoothing_t));
+  if (c.smoothing_r && !(*c.smoothing_r >= 0.0 && *c.smoothing_r <= kMaxSmoothing))
+    bad(S::SmoothingR, "smoothing_r must be in [0, 1e10], got " + std::to_string(*c.smoothing_r));
+  if (c.smoothing_t && !(*c.smoothing_t >= 0.0 && *c.smoothing_t <= kMaxSmoothing))
+    bad(S::SmoothingT, "smoothing_t must be in [0, 1e10], got " + std::to_string(*c.smoothing_t));
+  if (!(c.rate_hz >= 0.0) || !std::isfinite(c.rate_hz)) bad(S::Rate, "rate_hz must be finite and >= 0 (0: measured)");
+  if (c.cutoff_hz) {
+    if (!(*c.cutoff_hz > 0.0) || !std::isfinite(*c.cutoff_hz)) bad(S::Cutoff, "cutoff_hz must be positive");
+    if (c.rate_hz > 0.0 && !(*c.cutoff_hz < c.rate_hz / 2.0)) bad(S::Cutoff, "cutoff_hz must be below half of rate_hz");
+  }
+  const AdaptationSettings& a = c.adaptation;
+  for (double t : {a.noise_time_s, a.motion_time_s, a.motion_span_s})
+    if (!(t > 0.0 && t <= 600.0)) bad(S::Adaptation, "the adaptation's time constants must be in (0, 600] seconds");
   if (!(c.continuity >= 0.0) || !std::isfinite(c.continuity)) bad(S::Continuity, "continuity must be finite and >= 0");
+  if (c.continuity > 0.0) {
+    if (c.window == 0) bad(S::Continuity, "continuity needs a window in samples (its stability is checked for that window)");
+    if (c.window > 512) bad(S::Continuity, "continuity needs a window of at most 512 samples");
+    if (!resolvable(c, true) || !resolvable(c, false))
+      bad(S::Continuity, "continuity needs fixed smoothing (smoothing, or cutoff_hz with rate_hz): its stability is checked for it");
+  }
+  if (c.solver != WindowSolver::Linear) {
+    if (c.window == 0) bad(S::Window, "the iterative solvers need window in samples; window_s is the linear solver's");
+    if (c.solver == WindowSolver::GaussNewton && !resolvable(c, true))
+      bad(S::SmoothingR, "the gauss-newton solver needs smoothing (or cutoff_hz with rate_hz): adaptation is the linear solver's");
+  }
   if (!(c.lambda_r > 0.0 && c.lambda_r <= 1.0)) bad(S::LambdaR, "lambda_r must be in (0, 1]");
   if (!(c.lambda_t > 0.0 && c.lambda_t <= 1.0)) bad(S::LambdaT, "lambda_t must be in (0, 1]");
   if (!(c.epsilon_r > 0.0)) bad(S::EpsilonR, "epsilon_r must be positive");
   if (!(c.epsilon_t > 0.0)) bad(S::EpsilonT, "epsilon_t must be positive");
-  if (c.continuity > 0.0 && c.window > 512) bad(S::Continuity, "continuity needs a window of at most 512 samples");
   if (c.bound == BoundPolicy::Window && c.solver == WindowSolver::Linear)
     bad(S::Bound, "the window bound policy needs an iterative solver (gauss-newton or sweeps); linear solves in closed form");
 }
@@ -100,9 +153,26 @@ double smoothing_for_cutoff(double cutoff_hz, double rate_hz, int order) {
   return std::pow(s, -2.0 * order);
 }
 
-FairingWindow::FairingWindow(const WindowConfig& config) : config_(config), gate_(config.gate) {
-  validate(config);
-  const auto w = static_cast<std::size_t>(config.window);
+double cutoff_for_smoothing(double mu, double rate_hz, int order) {
+  if (!(rate_hz > 0.0)) return 0.0;
+  if (!(mu > 0.0)) return rate_hz / 2.0;  // no smoothing: everything up to Nyquist passes
+  const double s = std::pow(mu, -1.0 / (2.0 * order));
+  return rate_hz * std::asin(std::min(1.0, 0.5 * s)) / std::numbers::pi;
+}
+
+FairingWindow::Channel::Channel(int capacity, int order) : fixed(make_emission_row(capacity)), estimator(capacity, order) {}
+
+FairingWindow::FairingWindow(const WindowConfig& config)
+    : config_(config),
+      gate_(config.gate),
+      capacity_((validate(config), config.window > 0 ? config.window : config.max_window)),
+      w_(capacity_),
+      target_spec_{config.order, config.lag, 0.0, config.continuity},
+      builder_(capacity_, config.order),
+      fill_row_(make_emission_row(capacity_)),
+      rot_(capacity_, config.order),
+      pos_(capacity_, config.order) {
+  const auto w = static_cast<std::size_t>(capacity_);
   samples_.resize(w);
   z_.resize(w);
   x_.resize(w);
@@ -110,28 +180,144 @@ FairingWindow::FairingWindow(const WindowConfig& config) : config_(config), gate
   est_.resize(w);
   window_clamped_.assign(w, 0);
   c_.resize(w);
+  dzp_.resize(w);
+  cp_.resize(w);
   y_.resize(w);
   zp_.resize(w);
   xp_.resize(w);
   yp_.resize(w);
   e_.resize(w);
   u_.resize(w);
-  w_.resize(w + 1);
+  w_scratch_.resize(w + 1);
   rhs_.resize(w);
   target_.resize(w);
   diag_.resize(w);
-  if (config.solver != WindowSolver::DampedSweeps) {
-    // One factorisation per fill level n; samples with index < n-1-L have been emitted.
-    factors_r_.resize(w + 1);
-    factors_t_.resize(w + 1);
-    for (int n = 1; n <= config.window; ++n) {
-      for (int i = 0; i < n; ++i) diag_[static_cast<std::size_t>(i)] = 1.0 + (i < n - 1 - config.lag ? config.continuity : 0.0);
-      factors_r_[static_cast<std::size_t>(n)] = make_smoothing_system(n, config.order, config.smoothing_r, std::span(diag_).first(static_cast<std::size_t>(n)));
-      factors_t_[static_cast<std::size_t>(n)] = make_smoothing_system(n, config.order, config.smoothing_t, std::span(diag_).first(static_cast<std::size_t>(n)));
+  const bool linear = config.solver == WindowSolver::Linear;
+  rot_.adaptive = linear && smoothing_source(config, true) == SmoothingSource::Adaptive;
+  pos_.adaptive = linear && smoothing_source(config, false) == SmoothingSource::Adaptive;
+  if (rot_.adaptive || pos_.adaptive) levels_.assign(kMaxSmoothingLevels, make_emission_row(capacity_));
+  if (!linear) {
+    // The iterative solvers' settings are fixed at construction (validate() made sure they can be).
+    rot_.mu = resolvable(config, true) ? fixed_smoothing(config, true, config.rate_hz) : 0.0;
+    pos_.mu = resolvable(config, false) ? fixed_smoothing(config, false, config.rate_hz) : rot_.mu;
+    if (config.solver == WindowSolver::GaussNewton) {
+      // One factorisation per fill level n; samples with index < n-1-L have been emitted.
+      factors_r_.resize(w + 1);
+      factors_t_.resize(w + 1);
+      for (int n = 1; n <= config.window; ++n) {
+        for (int i = 0; i < n; ++i) diag_[static_cast<std::size_t>(i)] = 1.0 + (i < n - 1 - config.lag ? config.continuity : 0.0);
+        factors_r_[static_cast<std::size_t>(n)] = make_smoothing_system(n, config.order, rot_.mu, std::span(diag_).first(static_cast<std::size_t>(n)));
+        factors_t_[static_cast<std::size_t>(n)] = make_smoothing_system(n, config.order, pos_.mu, std::span(diag_).first(static_cast<std::size_t>(n)));
+      }
     }
-    if (config.solver == WindowSolver::Linear || config.continuity > 0.0) precompute_linear_rows();
-    if (config.continuity > 0.0) check_continuity_stability();
   }
+  if (config.rate_hz > 0.0 || !needs_rate()) prepare(config.rate_hz);
+  if (config.continuity > 0.0) {
+    if (!linear) builder_.build(config.window, rot_.mu, target_spec_, rot_.fixed);
+    check_continuity_stability();
+  }
+}
+
+bool FairingWindow::needs_rate() const {
+  if (config_.solver != WindowSolver::Linear) return false;
+  return config_.window == 0 || config_.horizon_s > 0.0 || smoothing_source(config_, true) != SmoothingSource::Given ||
+         smoothing_source(config_, false) != SmoothingSource::Given;
+}
+
+void FairingWindow::note_interval(double dt) {
+  if (prepared_ || !(dt > 0.0)) return;
+  intervals_[static_cast<std::size_t>(interval_count_++)] = dt;
+  if (interval_count_ < kRateIntervals) return;
+  std::array<double, kRateIntervals> sorted = intervals_;
+  std::nth_element(sorted.begin(), sorted.begin() + kRateIntervals / 2, sorted.end());
+  prepare(1.0 / sorted[kRateIntervals / 2]);
+}
+
+// Settles W, the emission rows and the estimators for this rate (0: not needed). Runs once,
+// at construction or after the first intervals; the storage exists already, so it allocates nothing.
+void FairingWindow::prepare(double rate_hz) {
+  rate_ = rate_hz;
+  const int m = config_.order;
+  if (config_.window > 0) {
+    w_ = config_.window;
+  } else {
+    const int shortest = std::max({kMinWindowSamples, config_.lag + 2, m + 1});
+    w_ = std::clamp(static_cast<int>(std::lround(config_.window_s * rate_hz)), std::min(shortest, capacity_), capacity_);
+  }
+  target_spec_.horizon = config_.horizon_s * rate_hz;
+  if (config_.solver == WindowSolver::Linear) {
+    for (Channel* ch : {&rot_, &pos_}) {
+      if (ch->adaptive) continue;
+      ch->mu = fixed_smoothing(config_, ch == &rot_, rate_hz);
+      builder_.build(w_, ch->mu, target_spec_, ch->fixed);
+    }
+    if (rot_.adaptive || pos_.adaptive) {
+      // Level 0 passes the measurements through; then cutoffs from 0.45 of the rate down, a
+      // third of an octave apart, until the smoothing is as heavy as the window can express.
+      level_count_ = 0;
+      builder_.build(w_, 0.0, target_spec_, levels_[static_cast<std::size_t>(level_count_++)]);
+      for (int j = 0; level_count_ < kMaxSmoothingLevels; ++j) {
+        const double nu = 0.45 * std::pow(2.0, -j / 3.0);
+        const double mu = std::pow(2.0 * std::sin(std::numbers::pi * nu), -2.0 * m);
+        if (mu > kMaxSmoothing) break;
+        builder_.build(w_, mu, target_spec_, levels_[static_cast<std::size_t>(level_count_++)]);
+      }
+      rot_.estimator.configure(rate_hz, config_.adaptation);
+      pos_.estimator.configure(rate_hz, config_.adaptation);
+    }
+  }
+  prepared_ = true;
+  if (n_ > w_) slide(n_ - w_);
+}
+
+void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
+  if (!ch.adaptive || !prepared_) return;
+  ch.estimator.update(zeta, dt);
+  if (!ch.estimator.ready()) {
+    ch.level = 0.0;
+    ch.mu = 0.0;
+    return;
+  }
+  ch.level = best_level(levels_, level_count_, ch.estimator.noise_variance(), config_.adaptation.motion_margin * ch.estimator.motion_variance());
+  // The μ a window still filling uses, and the one reported: geometric between the levels
+  // (linear from the pass-through level 0).
+  const int i = static_cast<int>(ch.level);
+  const double f = ch.level - i;
+  const double a = levels_[static_cast<std::size_t>(i)].mu;
+  const double b = i + 1 < level_count_ ? levels_[static_cast<std::size_t>(i + 1)].mu : a;
+  ch.mu = a > 0.0 ? a * std::pow(b / a, f) : f * b;
+}
+
+namespace {
+
+// u = Σ_j row.zeta_j ζ_j (+ Σ_i row.c_i c_i over emitted samples).
+Vec3 apply_row(const EmissionRow& row, int n, std::span<const Vec3> zeta, std::span<const Vec3> c, int emitted, bool continuity) {
+  Vec3 e = Vec3::Zero();
+  for (int j = row.first; j < n - 1; ++j) e += row.zeta[static_cast<std::size_t>(j)] * zeta[static_cast<std::size_t>(j)];
+  if (continuity)
+    for (int i = row.first; i < emitted; ++i) e += row.c[static_cast<std::size_t>(i)] * c[static_cast<std::size_t>(i)];
+  return e;
+}
+
+}  // namespace
+
+Vec3 FairingWindow::linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c) {
+  if (!prepared_) return Vec3::Zero();  // the rate is not known yet: the measurement passes
+  const int emitted = n_ - 1 - config_.lag;
+  const bool continuity = config_.continuity > 0.0;
+  if (n_ == w_) {
+    if (!ch.adaptive) return apply_row(ch.fixed, n_, zeta, c, emitted, continuity);
+    const int i = static_cast<int>(ch.level);
+    const double f = ch.level - i;
+    Vec3 e = apply_row(levels_[static_cast<std::size_t>(i)], n_, zeta, c, emitted, continuity);
+    if (f > 0.0 && i + 1 < level_count_)
+      e = (1.0 - f) * e + f * apply_row(levels_[static_cast<std::size_t>(i + 1)], n_, zeta, c, emitted, continuity);
+    return e;
+  }
+  // A window still filling (after the start or a gap): its row, built for this fill level.
+  if (ch.mu == 0.0 && config_.horizon_s == 0.0) return Vec3::Zero();
+  builder_.build(n_, ch.mu, target_spec_, fill_row_);
+  return apply_row(fill_row_, n_, zeta, c, emitted, continuity);
 }
 
 // With κ > 0 every emitted orientation feeds back into later ones: in a full window the
@@ -143,7 +329,7 @@ void FairingWindow::check_continuity_stability() const {
   const int w = config_.window, lag = config_.lag;
   const int taps = w - 1 - lag;  // emitted samples in a full window
   if (taps <= 0) return;
-  const auto& g = row_c_[static_cast<std::size_t>(w)];
+  const auto& g = rot_.fixed.c;
   Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(taps, taps);
   // c at window index taps-1 is the newest emitted (one step back), index 0 the oldest.
   for (int j = 1; j <= taps; ++j) companion(0, j - 1) = g[static_cast<std::size_t>(taps - j)];
@@ -151,85 +337,56 @@ void FairingWindow::check_continuity_stability() const {
   const double radius = companion.eigenvalues().cwiseAbs().maxCoeff();
   if (!(radius < 1.0 - 1e-9))
     throw InvalidEngineSetting(EngineSetting::Continuity, "continuity " + std::to_string(config_.continuity) + " with smoothing " +
-        std::to_string(config_.smoothing_r) + ", window " + std::to_string(w) + " and lag " +
+        std::to_string(rot_.mu) + ", window " + std::to_string(w) + " and lag " +
         std::to_string(lag) + " makes the output recursion unstable (spectral radius " +
         std::to_string(radius) + "); lower the continuity or the smoothing");
 }
 
-void FairingWindow::precompute_linear_rows() {
-  // Row k of A⁻¹ is r = A⁻¹ e_k (A is symmetric). The emitted estimate is
-  //   e_k = rᵀ(κ E c − μ (D^m)ᵀ D^{m−1} ζ) = Σ κ r_i c_i (emitted i) + hᵀζ,  h = −μ (D^{m−1})ᵀ D^m r,
-  //   p_k = rᵀ(z_p + κ E y_p).
-  const int w = config_.window, m = config_.order, lag = config_.lag;
-  row_zeta_.resize(static_cast<std::size_t>(w + 1));
-  row_c_.resize(static_cast<std::size_t>(w + 1));
-  row_p_.resize(static_cast<std::size_t>(w + 1));
-  std::vector<Vec3> unit(static_cast<std::size_t>(w));
-  for (int n = 1; n <= w; ++n) {
-    const int k = n - 1 - lag;
-    if (k < 0) continue;
-    for (const bool rotation : {true, false}) {
-      std::fill(unit.begin(), unit.end(), Vec3::Zero());
-      unit[static_cast<std::size_t>(k)] = Vec3::Ones();
-      (rotation ? factors_r_ : factors_t_)[static_cast<std::size_t>(n)].solve(std::span(unit).first(static_cast<std::size_t>(n)));
-      std::vector<double> r(static_cast<std::size_t>(n));
-      for (int i = 0; i < n; ++i) r[static_cast<std::size_t>(i)] = unit[static_cast<std::size_t>(i)].x();
-      auto& c = rotation ? row_c_[static_cast<std::size_t>(n)] : row_p_[static_cast<std::size_t>(n)];
-      c.assign(static_cast<std::size_t>(n), 0.0);
-      for (int i = 0; i < n; ++i) {
-        const bool emitted = i < n - 1 - lag;
-        c[static_cast<std::size_t>(i)] = rotation ? (emitted ? config_.continuity * r[static_cast<std::size_t>(i)] : 0.0)
-                                                  : r[static_cast<std::size_t>(i)];
-      }
-      if (!rotation) continue;
-      auto& h = row_zeta_[static_cast<std::size_t>(n)];
-      h.assign(static_cast<std::size_t>(std::max(0, n - 1)), 0.0);
-      if (n <= m || config_.smoothing_r == 0.0) continue;
-      // h = −μ (D^{m−1})ᵀ D^m r, with the same difference/adjoint passes the solver uses.
-      for (int i = 0; i < n; ++i) unit[static_cast<std::size_t>(i)] = Vec3::Constant(r[static_cast<std::size_t>(i)]);
-      int len = n;
-      for (int p = 0; p < m; ++p) difference(unit, len--);
-      for (int p = 1; p < m; ++p) difference_adjoint(unit, len++);
-      for (int j = 0; j < n - 1; ++j) h[static_cast<std::size_t>(j)] = -config_.smoothing_r * unit[static_cast<std::size_t>(j)].x();
+EngineState FairingWindow::state() const {
+  EngineState s;
+  s.rate_hz = rate_;
+  s.window = w_;
+  const double dt = rate_ > 0.0 ? 1.0 / rate_ : 0.0;
+  for (const bool rotation : {true, false}) {
+    const Channel& ch = rotation ? rot_ : pos_;
+    ChannelAdaptation& out = rotation ? s.rotation : s.position;
+    // Rotation channels work in half-angle vectors (so3::log): twice that is the angle.
+    const double unit = rotation ? 2.0 : 1.0;
+    out.adaptive = ch.adaptive;
+    out.smoothing = ch.mu;
+    out.cutoff_hz = cutoff_for_smoothing(ch.mu, rate_, config_.order);
+    if (ch.adaptive) {
+      out.noise = unit * std::sqrt(3.0 * ch.estimator.noise_variance());
+      out.motion = dt > 0.0 ? unit * std::sqrt(3.0 * ch.estimator.motion_variance()) / std::pow(dt, config_.order) : 0.0;
     }
   }
+  return s;
 }
 
-void FairingWindow::linear_emission_estimate(int k) {
-  const auto n = static_cast<std::size_t>(n_);
-  const auto& h = row_zeta_[n];
-  const auto& g = row_c_[n];
-  Vec3 e = Vec3::Zero();
-  for (std::size_t j = 0; j + 1 < n; ++j) e += h[j] * zeta_[j];
-  // Only emitted samples carry a c (the others' entries are stale or unset, and g is 0 there).
-  if (config_.continuity > 0.0)
-    for (std::size_t i = 0; static_cast<int>(i) < n_ - 1 - config_.lag; ++i) e += g[i] * c_[i];
-  est_[static_cast<std::size_t>(k)] = e;
-  if (positions_) {
-    const auto& rp = row_p_[n];
-    Vec3 p = Vec3::Zero();
-    const int emitted = n_ - 1 - config_.lag;
-    for (std::size_t i = 0; i < n; ++i) {
-      Vec3 v = zp_[i];
-      if (config_.continuity > 0.0 && static_cast<int>(i) < emitted) v += config_.continuity * yp_[i];
-      p += rp[i] * v;
-    }
-    xp_[static_cast<std::size_t>(k)] = p;
-  }
+void FairingWindow::linear_emission_estimate(int k, double dt) {
+  const auto d = static_cast<std::size_t>(std::max(0, n_ - 1));
+  adapt(rot_, std::span<const Vec3>(zeta_).first(d), dt);
+  if (positions_) adapt(pos_, std::span<const Vec3>(dzp_).first(d), dt);
+  if (k < 0) return;
+  est_[static_cast<std::size_t>(k)] = linear_correction(rot_, zeta_, c_);
+  if (positions_) xp_[static_cast<std::size_t>(k)] = zp_[static_cast<std::size_t>(k)] + linear_correction(pos_, dzp_, cp_);
 }
 
 std::size_t FairingWindow::memory_bytes() const {
   std::size_t bytes = sizeof(*this);
   bytes += samples_.capacity() * sizeof(Sample);
   bytes += (z_.capacity() + x_.capacity() + y_.capacity() + target_.capacity()) * sizeof(Quat);
-  bytes += (zeta_.capacity() + est_.capacity() + c_.capacity()) * sizeof(Vec3);
-  bytes += (zp_.capacity() + xp_.capacity() + yp_.capacity() + e_.capacity() + u_.capacity() + w_.capacity() +
+  bytes += (zeta_.capacity() + est_.capacity() + c_.capacity() + dzp_.capacity() + cp_.capacity()) * sizeof(Vec3);
+  bytes += (zp_.capacity() + xp_.capacity() + yp_.capacity() + e_.capacity() + u_.capacity() + w_scratch_.capacity() +
             rhs_.capacity()) * sizeof(Vec3);
   bytes += diag_.capacity() * sizeof(double) + window_clamped_.capacity();
-  for (const auto* rows : {&row_zeta_, &row_c_, &row_p_}) {
-    bytes += rows->capacity() * sizeof(std::vector<double>);
-    for (const auto& r : *rows) bytes += r.capacity() * sizeof(double);
-  }
+  auto row_bytes = [](const EmissionRow& r) { return (r.zeta.capacity() + r.c.capacity()) * sizeof(double); };
+  bytes += levels_.capacity() * sizeof(EmissionRow);
+  for (const EmissionRow& r : levels_) bytes += row_bytes(r);
+  bytes += row_bytes(fill_row_) + row_bytes(rot_.fixed) + row_bytes(pos_.fixed);
+  // The builder's band matrix and scratch, and the estimators' fit weights.
+  bytes += static_cast<std::size_t>(capacity_) * (static_cast<std::size_t>(config_.order + 1) + 5) * sizeof(double) +
+           static_cast<std::size_t>(capacity_ + 1) * sizeof(Vec3) + 2 * static_cast<std::size_t>(capacity_) * sizeof(double);
   for (const auto* set : {&factors_r_, &factors_t_}) {
     bytes += set->capacity() * sizeof(BandedCholesky);
     for (const BandedCholesky& f : *set) bytes += static_cast<std::size_t>(f.size() * (f.bandwidth() + 1)) * sizeof(double);
@@ -251,6 +408,7 @@ FairedPose FairingWindow::emit(int index) {
   if (config_.solver == WindowSolver::Linear && config_.continuity > 0.0) c_[k] = so3::log(z_[k].conjugate() * q);
   Vec3 p = xp_[k];
   if (positions_) clamped = project_position(zp_[k], p, config_.epsilon_t) || clamped;
+  if (positions_ && config_.solver == WindowSolver::Linear && config_.continuity > 0.0) cp_[k] = p - zp_[k];
   // With the window policy the projection may already have happened inside the solve.
   clamped = clamped || window_clamped_[k];
   if (clamped) ++counters_.clamped;
@@ -261,7 +419,7 @@ FairedPose FairingWindow::emit(int index) {
   FairedPose out;
   out.stream_id = s.stream_id;
   out.sequence = s.sequence;
-  out.time = s.time;
+  out.time = s.time + config_.horizon_s;  // a prediction is stamped with the time it is for
   out.orientation = q;
   out.position = positions_ ? p : Vec3::Zero();
   out.measured = s.orientation;
@@ -291,11 +449,16 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
     count = emit_pending(out);
     ++counters_.restarts;
   }
+  const double dt = have_time_ && verdict == GateVerdict::Accept ? s.time - last_time_ : 0.0;
+  last_time_ = s.time;
+  have_time_ = true;
   append(s);
+  if (!prepared_) note_interval(dt);
   const int k = n_ - 1 - config_.lag;
   if (config_.solver == WindowSolver::Linear) {
-    // Only the emitted sample's estimate is needed: one precomputed dot product.
-    if (k >= 0) linear_emission_estimate(k);
+    // Only the emitted sample's estimate is needed: one precomputed dot product (two while
+    // the adapted smoothing lies between levels).
+    linear_emission_estimate(k, dt);
   } else {
     solve();
   }
@@ -303,27 +466,32 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   return count;
 }
 
+void FairingWindow::slide(int count) {
+  // Drop the oldest `count` samples (emitted long ago). W moves of a few dozen bytes each.
+  auto drop = [&](auto& v) { std::move(v.begin() + count, v.begin() + n_, v.begin()); };
+  drop(samples_);
+  drop(z_);
+  if (config_.solver == WindowSolver::Linear) {
+    drop(zeta_);
+    drop(c_);
+    drop(dzp_);
+    drop(cp_);
+  } else {
+    drop(x_);
+    drop(y_);
+    drop(window_clamped_);
+  }
+  if (positions_) {
+    drop(zp_);
+    drop(xp_);
+    drop(yp_);
+  }
+  n_ -= count;
+}
+
 void FairingWindow::append(const Sample& s) {
   if (n_ == 0) positions_ = s.has_position();
-  if (n_ == config_.window) {
-    // Slide: drop the oldest (emitted long ago). W moves of a few dozen bytes each.
-    std::move(samples_.begin() + 1, samples_.end(), samples_.begin());
-    std::move(z_.begin() + 1, z_.end(), z_.begin());
-    if (config_.solver == WindowSolver::Linear) {
-      std::move(zeta_.begin() + 1, zeta_.end(), zeta_.begin());
-      std::move(c_.begin() + 1, c_.end(), c_.begin());
-    } else {
-      std::move(x_.begin() + 1, x_.end(), x_.begin());
-      std::move(y_.begin() + 1, y_.end(), y_.begin());
-      std::move(window_clamped_.begin() + 1, window_clamped_.end(), window_clamped_.begin());
-    }
-    if (positions_) {
-      std::move(zp_.begin() + 1, zp_.end(), zp_.begin());
-      std::move(xp_.begin() + 1, xp_.end(), xp_.begin());
-      std::move(yp_.begin() + 1, yp_.end(), yp_.begin());
-    }
-    --n_;
-  }
+  if (n_ == w_) slide(1);
   const auto k = static_cast<std::size_t>(n_);
   samples_[k] = s;
   window_clamped_[k] = 0;
@@ -336,7 +504,10 @@ void FairingWindow::append(const Sample& s) {
   z_[k] = z;
   if (config_.solver == WindowSolver::Linear) {
     if (n_ >= 1) zeta_[k - 1] = so3::log(z_[k - 1].conjugate() * z);
-    if (positions_) zp_[k] = s.position;
+    if (positions_) {
+      zp_[k] = s.position;
+      if (n_ >= 1) dzp_[k - 1] = s.position - zp_[k - 1];
+    }
     ++n_;
     return;
   }
@@ -359,8 +530,7 @@ void FairingWindow::append(const Sample& s) {
 
 void FairingWindow::solve() {
   if (config_.solver == WindowSolver::Linear) {
-    linear_rotation(factors_r_[static_cast<std::size_t>(n_)]);
-    if (positions_) solve_positions(factors_t_[static_cast<std::size_t>(n_)]);
+    linear_window();
   } else if (config_.solver == WindowSolver::GaussNewton) {
     for (int it = 0; it < config_.iterations; ++it) {
       gauss_newton_rotation(factors_r_[static_cast<std::size_t>(n_)]);
@@ -375,33 +545,44 @@ void FairingWindow::solve() {
   }
 }
 
+// The whole window at once (a flush): every correction, at each channel's current μ.
+void FairingWindow::linear_window() {
+  const int n = n_;
+  const int emitted = n - 1 - config_.lag;
+  const bool continuity = config_.continuity > 0.0;
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    est_[k] = continuity && i < emitted ? Vec3(config_.continuity * c_[k]) : Vec3::Zero();
+    e_[k] = continuity && i < emitted ? Vec3(config_.continuity * cp_[k]) : Vec3::Zero();
+  }
+  if (!prepared_) {
+    for (int i = 0; i < n; ++i) xp_[static_cast<std::size_t>(i)] = zp_[static_cast<std::size_t>(i)];
+    return;  // the rate is not known yet: the measurements pass
+  }
+  EmissionTarget whole = target_spec_;
+  whole.horizon = 0.0;
+  builder_.solve_window(n, rot_.mu, whole, zeta_, est_);
+  if (positions_) {
+    builder_.solve_window(n, pos_.mu, whole, dzp_, e_);
+    for (int i = 0; i < n; ++i) xp_[static_cast<std::size_t>(i)] = zp_[static_cast<std::size_t>(i)] + e_[static_cast<std::size_t>(i)];
+  }
+}
+
 // rhs -= μ (D^m)ᵀ D^{m-1} w1, where w1 (in w_, n-1 entries) is W¹ of the linearisation point:
 // the gradient of μ‖W^m x‖² with W^m x = D^{m-1} W¹x and W¹ linear in the correction.
 void FairingWindow::smoothness_gradient(std::span<const Vec3> w1) {
   const int n = n_, m = config_.order;
-  if (w1.data() != w_.data()) std::copy(w1.begin(), w1.begin() + (n - 1), w_.begin());
+  if (w1.data() != w_scratch_.data()) std::copy(w1.begin(), w1.begin() + (n - 1), w_scratch_.begin());
   int len = n - 1;
-  for (int p = 1; p < m; ++p) difference(w_, len--);
-  for (int p = 0; p < m; ++p) difference_adjoint(w_, len++);
-  for (int i = 0; i < n; ++i) rhs_[static_cast<std::size_t>(i)] -= config_.smoothing_r * w_[static_cast<std::size_t>(i)];
-}
-
-void FairingWindow::linear_rotation(const BandedCholesky& a) {
-  const int n = n_;
-  const int emitted = n - 1 - config_.lag;
-  for (int i = 0; i < n; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    rhs_[k] = config_.continuity > 0.0 && i < emitted ? Vec3(config_.continuity * c_[k]) : Vec3::Zero();
-  }
-  if (n > config_.order && config_.smoothing_r > 0.0) smoothness_gradient(std::span<const Vec3>(zeta_).first(static_cast<std::size_t>(n - 1)));
-  a.solve(std::span(rhs_).first(static_cast<std::size_t>(n)));
-  std::copy(rhs_.begin(), rhs_.begin() + n, est_.begin());
+  for (int p = 1; p < m; ++p) difference(w_scratch_, len--);
+  for (int p = 0; p < m; ++p) difference_adjoint(w_scratch_, len++);
+  for (int i = 0; i < n; ++i) rhs_[static_cast<std::size_t>(i)] -= rot_.mu * w_scratch_[static_cast<std::size_t>(i)];
 }
 
 void FairingWindow::gauss_newton_rotation(const BandedCholesky& a) {
   const int n = n_;
   const int m = config_.order;
-  const double mu = config_.smoothing_r;
+  const double mu = rot_.mu;
   const double kappa = config_.continuity;
   const int emitted = n - 1 - config_.lag;  // indices below this were emitted
   for (int i = 0; i < n; ++i) {
@@ -411,8 +592,8 @@ void FairingWindow::gauss_newton_rotation(const BandedCholesky& a) {
     rhs_[k] = -g;
   }
   if (n > m && mu > 0.0) {
-    for (int j = 0; j + 1 < n; ++j) w_[static_cast<std::size_t>(j)] = so3::log(x_[static_cast<std::size_t>(j)].conjugate() * x_[static_cast<std::size_t>(j + 1)]);
-    smoothness_gradient(w_);
+    for (int j = 0; j + 1 < n; ++j) w_scratch_[static_cast<std::size_t>(j)] = so3::log(x_[static_cast<std::size_t>(j)].conjugate() * x_[static_cast<std::size_t>(j + 1)]);
+    smoothness_gradient(w_scratch_);
   }
   a.solve(std::span(rhs_).first(static_cast<std::size_t>(n)));
   for (int i = 0; i < n; ++i) {

@@ -130,7 +130,7 @@ constexpr std::string_view kRootKeys[] = {"daemon", "logging", "engine", "stream
 constexpr std::string_view kDaemonKeys[] = {"exit_when_sources_end", "session_id", "realtime_priority"};
 constexpr std::string_view kLoggingKeys[] = {"level", "target", "status_interval"};
 constexpr std::string_view kEngineKeys[] = {
-    "window",   "lag",      "order",    "solver",    "iterations", "smoothing", "smoothing_r",
+    "window",   "window_time", "max_window", "lag", "horizon", "order", "solver", "iterations", "smoothing", "smoothing_r",
     "smoothing_t", "cutoff_hz", "rate_hz", "continuity", "lambda_r", "lambda_t", "variant",
     "epsilon_r", "epsilon_t", "bound",  "gap",       "unit_tolerance"};
 constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "overflow", "driver", "engine", "spline", "gpio"};
@@ -307,9 +307,9 @@ struct Given {
 struct EngineLayer {
   const toml::table* table = nullptr;
   std::string prefix;
-  std::optional<Given<int>> window, lag, order, iterations;
+  std::optional<Given<int>> window, max_window, lag, order, iterations;
   std::optional<Given<WindowSolver>> solver;
-  std::optional<Given<double>> smoothing, smoothing_r, smoothing_t, cutoff_hz, rate_hz, continuity, lambda_r,
+  std::optional<Given<double>> window_time, horizon, smoothing, smoothing_r, smoothing_t, cutoff_hz, rate_hz, continuity, lambda_r,
       lambda_t, epsilon_r, epsilon_t, gap, unit_tolerance;
   std::optional<Given<OperatorVariant>> variant;
   std::optional<Given<BoundPolicy>> bound;
@@ -518,7 +518,10 @@ class Parser {
       }
     };
     integer("window", e.window, 2, 4096);
+    real("window_time", e.window_time, FloatRange{0.0, true, 60.0, false});
+    integer("max_window", e.max_window, kMinWindowSamples, 4096);
     integer("lag", e.lag, 0, 4095);
+    real("horizon", e.horizon, FloatRange{0.0, false, 1.0, false});
     if (const toml::node* n = t.get("order")) {
       const std::string key = join_key(prefix, "order");
       if (!n->is_integer()) wrong_type(*n, key, "an integer");
@@ -587,7 +590,10 @@ class Parser {
         }
       };
       take(layer->window, c.window, EngineSetting::Window);
+      take(layer->window_time, c.window_s, EngineSetting::Window);
+      take(layer->max_window, c.max_window, EngineSetting::Window);
       take(layer->lag, c.lag, EngineSetting::Lag);
+      take(layer->horizon, c.horizon_s, EngineSetting::Horizon);
       take(layer->order, c.order, EngineSetting::Order);
       take(layer->solver, c.solver, EngineSetting::Solver);
       take(layer->iterations, c.iterations, EngineSetting::Iterations);
@@ -621,16 +627,24 @@ class Parser {
     else if (global.rate_hz)
       rate = global.rate_hz;
 
-    auto resolve_smoothing = [&](const Smoothing& s, double& field, EngineSetting setting) {
+    if (rate) {
+      c.rate_hz = rate->value;
+      origin[EngineSetting::Rate] = rate->where;
+    }
+    // Unset, a half is adapted to the stream; a cutoff without a known rate is turned into μ by
+    // the engine at the rate it measures.
+    auto resolve_smoothing = [&](const Smoothing& s, std::optional<double>& field, EngineSetting setting) {
       if (!s.set) return;
       origin[setting] = s.where;
       if (!s.from_cutoff) {
         field = s.value;
         return;
       }
-      if (!rate)
-        fail(s.where, "needs rate_hz, the stream's sample rate in Hz (in [engine] or [stream.engine])" +
-                          std::string(s.where.key.starts_with(stream_prefix) ? "" : " for " + stream_prefix + " " + in_quotes(stream_name)));
+      if (!rate) {
+        c.cutoff_hz = s.value;
+        origin[EngineSetting::Cutoff] = s.where;
+        return;
+      }
       try {
         field = smoothing_for_cutoff(s.value, rate->value, c.order);
       } catch (const std::invalid_argument&) {
@@ -671,7 +685,7 @@ class Parser {
       const Smoothing* s = nullptr;
       if (refused && refused->setting() == EngineSetting::SmoothingR) s = &r;
       if (refused && refused->setting() == EngineSetting::SmoothingT) s = &t;
-      if (s != nullptr && s->from_cutoff)
+      if (s != nullptr && s->from_cutoff && rate)
         message = "cutoff_hz " + number(s->value) + " Hz at rate_hz " + number(rate->value) + " Hz gives " + what;
       if (!at.key.starts_with(stream_prefix)) message += " (for " + stream_prefix + " " + in_quotes(stream_name) + ")";
       fail(at, message);

@@ -38,6 +38,39 @@ std::filesystem::path expand_time_pattern(const std::filesystem::path& path) {
   return path.parent_path() / std::string(buf, n);
 }
 
+// The engine's state through relaxed atomics: written by the engine thread, read for reports.
+void store_engine_state(StreamCounters& c, const EngineState& e) {
+  constexpr auto relaxed = std::memory_order_relaxed;
+  c.engine_rate_hz.store(e.rate_hz, relaxed);
+  c.engine_window.store(e.window, relaxed);
+  for (const bool rotation : {true, false}) {
+    const ChannelAdaptation& from = rotation ? e.rotation : e.position;
+    StreamCounters::Channel& to = rotation ? c.rotation : c.position;
+    to.adaptive.store(from.adaptive, relaxed);
+    to.noise.store(from.noise, relaxed);
+    to.motion.store(from.motion, relaxed);
+    to.smoothing.store(from.smoothing, relaxed);
+    to.cutoff_hz.store(from.cutoff_hz, relaxed);
+  }
+}
+
+EngineState load_engine_state(const StreamCounters& c) {
+  constexpr auto relaxed = std::memory_order_relaxed;
+  EngineState e;
+  e.rate_hz = c.engine_rate_hz.load(relaxed);
+  e.window = c.engine_window.load(relaxed);
+  for (const bool rotation : {true, false}) {
+    const StreamCounters::Channel& from = rotation ? c.rotation : c.position;
+    ChannelAdaptation& to = rotation ? e.rotation : e.position;
+    to.adaptive = from.adaptive.load(relaxed);
+    to.noise = from.noise.load(relaxed);
+    to.motion = from.motion.load(relaxed);
+    to.smoothing = from.smoothing.load(relaxed);
+    to.cutoff_hz = from.cutoff_hz.load(relaxed);
+  }
+  return e;
+}
+
 }  // namespace
 
 // Drained per ring per pass, so one busy stream cannot starve the others.
@@ -308,6 +341,7 @@ void Pipeline::engine_loop() {
       s.counters.emitted.store(w.emitted, std::memory_order_relaxed);
       s.counters.clamped.store(w.clamped, std::memory_order_relaxed);
       s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
+      store_engine_state(s.counters, s.window.state());
       if (s.bridge) {
         s.counters.bridged_gaps.store(s.bridge->counters().gaps, std::memory_order_relaxed);
         s.counters.bridged_samples.store(s.bridge->counters().samples, std::memory_order_relaxed);
@@ -393,6 +427,7 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.emitted = get(s.counters.emitted);
     st.clamped = get(s.counters.clamped);
     st.restarts = get(s.counters.restarts);
+    st.engine = load_engine_state(s.counters);
     st.publish_dropped = s.pose_ring.dropped();
     st.published = get(s.counters.published);
     st.send_failures = get(s.counters.send_failures);

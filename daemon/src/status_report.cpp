@@ -55,6 +55,30 @@ std::string gpio_text(const std::optional<drivers::GpioDataReadyCounters>& in,
   return text;
 }
 
+// "; engine 285.7 Hz, window 128, rotation adapted: noise 0.0012 rad, motion 3.1 rad/s^2,
+//  cutoff 8.2 Hz (mu 352)" — the adaptation's measurements and choice, or the fixed smoothing.
+std::string engine_text(const EngineState& e) {
+  std::string text;
+  char buf[240];
+  if (e.rate_hz > 0.0)
+    std::snprintf(buf, sizeof buf, "; engine %.4g Hz, window %d", e.rate_hz, e.window);
+  else
+    std::snprintf(buf, sizeof buf, "; engine rate not yet measured");
+  text += buf;
+  auto channel = [&](const char* name, const ChannelAdaptation& a, const char* unit) {
+    if (a.adaptive)
+      std::snprintf(buf, sizeof buf, ", %s adapted: noise %.3g %s, motion %.3g %s/s^m, cutoff %.3g Hz (mu %.4g)", name, a.noise,
+                    unit, a.motion, unit, a.cutoff_hz, a.smoothing);
+    else
+      std::snprintf(buf, sizeof buf, ", %s fixed: cutoff %.3g Hz (mu %.4g)", name, a.cutoff_hz, a.smoothing);
+    text += buf;
+  };
+  channel("rotation", e.rotation, "rad");
+  // Positions once the adaptation has measured some (a stream without them shows none).
+  if (e.position.adaptive ? e.position.noise > 0.0 : e.position.smoothing > 0.0) channel("position", e.position, "units");
+  return text;
+}
+
 }  // namespace
 
 std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, const std::vector<StreamStats>& previous,
@@ -88,6 +112,7 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
       std::snprintf(buf, sizeof buf, ", lerp fallbacks %" PRIu64, s.lerp_fallbacks);
       lines.back() += buf;
     }
+    lines.back() += engine_text(s.engine);
     if (s.device) lines.back() += device_text(*s.device);
     lines.back() += gpio_text(s.data_ready, s.gpio_output);
   }
@@ -103,6 +128,11 @@ std::string status_line(const std::vector<StreamStats>& now, const std::vector<S
     std::snprintf(buf, sizeof buf, "%s%s %.1f/s drop %" PRIu64 " p99 %.0fus", out.empty() ? "" : "; ", s.name.c_str(),
                   p ? rate(s.emitted, p->emitted, seconds) : 0.0, s.dropped(), us(interval.percentile(99)));
     out += buf;
+    // What the smoothing is doing: its cutoff now (adapted or fixed), once the rate is known.
+    if (s.engine.rate_hz > 0.0) {
+      std::snprintf(buf, sizeof buf, " fc %.3gHz%s", s.engine.rotation.cutoff_hz, s.engine.rotation.adaptive ? " (adapted)" : "");
+      out += buf;
+    }
     // A device stream says when its device is away and how often it went: what `systemctl
     // status` readers need first.
     if (s.device) {

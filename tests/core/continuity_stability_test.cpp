@@ -14,7 +14,7 @@ TEST(ContinuityStability, ThirdOrderWithStrongContinuityIsRefused) {
   WindowConfig c;
   c.order = 3;
   c.window = 32;
-  c.smoothing_r = 1e4;
+  c.smoothing_r = c.smoothing_t = 1e4;
   c.continuity = 100.0;
   try {
     FairingWindow w(c);
@@ -37,7 +37,7 @@ TEST(ContinuityStability, AcceptedContinuityStaysBoundedOverALongStream) {
     WindowConfig c;
     c.order = m;
     c.window = 32;
-    c.smoothing_r = smoothing_for_cutoff(4.0, 1000.0, m);
+    c.smoothing_r = c.smoothing_t = smoothing_for_cutoff(4.0, 1000.0, m);
     c.continuity = 1.0;
     ASSERT_NO_THROW(FairingWindow{c});
     const auto r = fair_causal(motion.noisy, c);

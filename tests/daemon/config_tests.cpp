@@ -195,8 +195,8 @@ TEST(Config, AFullConfigFillsEveryField) {
     EXPECT_EQ(e.order, 3);
     EXPECT_EQ(e.solver, WindowSolver::GaussNewton);
     EXPECT_EQ(e.iterations, 3);
-    EXPECT_DOUBLE_EQ(e.smoothing_r, smoothing_for_cutoff(10.0, 200.0, 3));
-    EXPECT_DOUBLE_EQ(e.smoothing_t, smoothing_for_cutoff(10.0, 200.0, 3));
+    EXPECT_DOUBLE_EQ(e.smoothing_r.value_or(-1.0), smoothing_for_cutoff(10.0, 200.0, 3));
+    EXPECT_DOUBLE_EQ(e.smoothing_t.value_or(-1.0), smoothing_for_cutoff(10.0, 200.0, 3));
     EXPECT_EQ(e.continuity, 0.5);
     EXPECT_EQ(e.lambda_r, WindowConfig{}.lambda_r);
     EXPECT_EQ(e.lambda_t, WindowConfig{}.lambda_t);
@@ -224,8 +224,8 @@ TEST(Config, AFullConfigFillsEveryField) {
     EXPECT_EQ(e.order, 3);
     EXPECT_EQ(e.solver, WindowSolver::DampedSweeps);
     EXPECT_EQ(e.iterations, 4);
-    EXPECT_EQ(e.smoothing_r, 50.0);
-    EXPECT_EQ(e.smoothing_t, 500.0);
+    EXPECT_EQ(e.smoothing_r.value_or(-1.0), 50.0);
+    EXPECT_EQ(e.smoothing_t.value_or(-1.0), 500.0);
     EXPECT_EQ(e.continuity, 0.0);
     EXPECT_EQ(e.lambda_r, 0.2);
     EXPECT_EQ(e.lambda_t, 0.6);
@@ -252,8 +252,8 @@ TEST(Config, AFullConfigFillsEveryField) {
     EXPECT_EQ(e.order, 3);
     EXPECT_EQ(e.solver, WindowSolver::Linear);
     EXPECT_EQ(e.iterations, 1);
-    EXPECT_EQ(e.smoothing_r, 500.0);
-    EXPECT_EQ(e.smoothing_t, 500.0);
+    EXPECT_EQ(e.smoothing_r.value_or(-1.0), 500.0);
+    EXPECT_EQ(e.smoothing_t.value_or(-1.0), 500.0);
     EXPECT_DOUBLE_EQ(e.epsilon_r, 0.02);
     EXPECT_EQ(e.epsilon_t, 0.5);
     EXPECT_EQ(e.gate.gap_threshold, 0.5);
@@ -326,8 +326,11 @@ driver = { type = "synthetic" }
   EXPECT_EQ(e.order, d.order);
   EXPECT_EQ(e.solver, d.solver);
   EXPECT_EQ(e.iterations, d.iterations);
-  EXPECT_EQ(e.smoothing_r, d.smoothing_r);
+  EXPECT_EQ(e.smoothing_r, d.smoothing_r);  // unset: adapted to the stream
   EXPECT_EQ(e.smoothing_t, d.smoothing_t);
+  EXPECT_EQ(e.cutoff_hz, d.cutoff_hz);
+  EXPECT_EQ(e.window_s, d.window_s);
+  EXPECT_EQ(e.horizon_s, d.horizon_s);
   EXPECT_EQ(e.continuity, d.continuity);
   EXPECT_EQ(e.lambda_r, d.lambda_r);
   EXPECT_EQ(e.lambda_t, d.lambda_t);
@@ -751,15 +754,15 @@ engine = { cutoff_hz = 2, order = 2 }
                                       dir / "cfg.toml");
   ASSERT_EQ(c.streams.size(), 6u);
   const double at100 = smoothing_for_cutoff(5.0, 100.0, 3);
-  EXPECT_EQ(c.streams[0].engine.smoothing_r, 300.0);
-  EXPECT_EQ(c.streams[0].engine.smoothing_t, 300.0);
-  EXPECT_DOUBLE_EQ(c.streams[1].engine.smoothing_r, at100);
-  EXPECT_EQ(c.streams[1].engine.smoothing_t, 300.0);
-  EXPECT_DOUBLE_EQ(c.streams[2].engine.smoothing_r, at100);
-  EXPECT_DOUBLE_EQ(c.streams[2].engine.smoothing_t, at100);
-  EXPECT_DOUBLE_EQ(c.streams[3].engine.smoothing_r, smoothing_for_cutoff(5.0, 400.0, 3));
-  EXPECT_DOUBLE_EQ(c.streams[4].engine.smoothing_r, smoothing_for_cutoff(5.0, 50.0, 3));
-  EXPECT_DOUBLE_EQ(c.streams[5].engine.smoothing_t, smoothing_for_cutoff(2.0, 100.0, 2));
+  EXPECT_EQ(c.streams[0].engine.smoothing_r.value_or(-1.0), 300.0);
+  EXPECT_EQ(c.streams[0].engine.smoothing_t.value_or(-1.0), 300.0);
+  EXPECT_DOUBLE_EQ(c.streams[1].engine.smoothing_r.value_or(-1.0), at100);
+  EXPECT_EQ(c.streams[1].engine.smoothing_t.value_or(-1.0), 300.0);
+  EXPECT_DOUBLE_EQ(c.streams[2].engine.smoothing_r.value_or(-1.0), at100);
+  EXPECT_DOUBLE_EQ(c.streams[2].engine.smoothing_t.value_or(-1.0), at100);
+  EXPECT_DOUBLE_EQ(c.streams[3].engine.smoothing_r.value_or(-1.0), smoothing_for_cutoff(5.0, 400.0, 3));
+  EXPECT_DOUBLE_EQ(c.streams[4].engine.smoothing_r.value_or(-1.0), smoothing_for_cutoff(5.0, 50.0, 3));
+  EXPECT_DOUBLE_EQ(c.streams[5].engine.smoothing_t.value_or(-1.0), smoothing_for_cutoff(2.0, 100.0, 2));
 
   // And the other way round: a stream's cutoff_hz replaces [engine]'s smoothing.
   const DaemonConfig d = parse_config(R"toml(
@@ -772,8 +775,22 @@ driver = { type = "synthetic", rate_hz = 250 }
 engine = { cutoff_hz = 10 }
 )toml",
                                       dir / "cfg.toml");
-  EXPECT_DOUBLE_EQ(d.streams.at(0).engine.smoothing_r, smoothing_for_cutoff(10.0, 250.0, 2));
-  EXPECT_DOUBLE_EQ(d.streams.at(0).engine.smoothing_t, smoothing_for_cutoff(10.0, 250.0, 2));
+  EXPECT_DOUBLE_EQ(d.streams.at(0).engine.smoothing_r.value_or(-1.0), smoothing_for_cutoff(10.0, 250.0, 2));
+  EXPECT_DOUBLE_EQ(d.streams.at(0).engine.smoothing_t.value_or(-1.0), smoothing_for_cutoff(10.0, 250.0, 2));
+
+  // Without a known rate the cutoff goes to the engine, which applies it at the rate it measures.
+  const DaemonConfig e = parse_config(R"toml(
+[engine]
+cutoff_hz = 8
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "replay", path = "poses.csv" }
+)toml",
+                                      dir / "cfg.toml");
+  EXPECT_EQ(e.streams.at(0).engine.cutoff_hz, std::optional<double>(8.0));
+  EXPECT_FALSE(e.streams.at(0).engine.smoothing_r.has_value());
+  EXPECT_EQ(e.streams.at(0).engine.rate_hz, 0.0);
 }
 
 TEST(Config, OutputsOfTheSameOptionlessEncodingShareOneEncoder) {
@@ -823,8 +840,8 @@ TEST(Config, TheDemoConfigReplaysTheBundledExcerpt) {
   EXPECT_EQ(s.engine.order, 3);
   EXPECT_EQ(s.engine.window, 32);
   EXPECT_EQ(s.engine.lag, 0);
-  EXPECT_DOUBLE_EQ(s.engine.smoothing_r, smoothing_for_cutoff(8.0, 285.7, 3));
-  EXPECT_DOUBLE_EQ(s.engine.smoothing_t, smoothing_for_cutoff(8.0, 285.7, 3));
+  EXPECT_DOUBLE_EQ(s.engine.smoothing_r.value_or(-1.0), smoothing_for_cutoff(8.0, 285.7, 3));
+  EXPECT_DOUBLE_EQ(s.engine.smoothing_t.value_or(-1.0), smoothing_for_cutoff(8.0, 285.7, 3));
   EXPECT_DOUBLE_EQ(s.engine.epsilon_r, 0.01);
   EXPECT_DOUBLE_EQ(s.engine.epsilon_t, 0.002);
   ASSERT_EQ(c.outputs.size(), 1u);
@@ -1053,20 +1070,37 @@ exit_when_sources_end = true
     {"[stream] instead of [[stream]]", R"([stream]
 id = 1
 )", "stream: expected an array of tables ([[stream]]), got a table", 1},
-    {"cutoff_hz without rate_hz", R"([[stream]]
+    {"horizon with a lag", R"([[stream]]
 id = 1
 name = "a"
-driver = { type = "replay", path = "poses.csv" }
+driver = { type = "synthetic", rate_hz = 100 }
 [stream.engine]
-cutoff_hz = 8
-)", "stream[1].engine.cutoff_hz: needs rate_hz", 6},
-    {"cutoff_hz in [engine] without rate_hz", R"([engine]
-cutoff_hz = 8
+lag = 2
+horizon = 0.02
+)", "stream[1].engine.horizon: a horizon (prediction) needs lag 0", 7},
+    {"horizon with an epsilon bound", R"([engine]
+epsilon_r = 0.05
+horizon = 0.02
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+)", "engine.horizon: a horizon (prediction) cannot be combined with an epsilon bound", 3},
+    {"window_time out of range", R"([engine]
+window_time = 0
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+)", "engine.window_time: out of range: must be in (0, 60], got 0", 2},
+    {"continuity with adapted smoothing", R"([engine]
+window = 32
+continuity = 1
 [[stream]]
 id = 1
 name = "a"
 driver = { type = "replay", path = "poses.csv" }
-)", "engine.cutoff_hz: needs rate_hz, the stream's sample rate in Hz (in [engine] or [stream.engine]) for stream[1] 'a'", 2},
+)", "engine.continuity: continuity needs fixed smoothing", 3},
     {"cutoff_hz above half the rate", R"([[stream]]
 id = 1
 name = "a"

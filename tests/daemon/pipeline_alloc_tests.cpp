@@ -60,7 +60,8 @@ std::string config_text(std::uint16_t port, const std::string& driver, const std
          solver +
          "\"\n"
          "order = 3\n"
-         "window = 32\n"
+         "window = 32\n" +
+         std::string(solver == "gauss-newton" ? "smoothing = 100\n" : "") +
          "lag = 4\n"
          "\n"
          "[[output]]\n"

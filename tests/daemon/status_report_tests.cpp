@@ -42,6 +42,28 @@ TEST(StatusReport, CounterLineWithoutDeviceHasNoDevicePart) {
   EXPECT_EQ(lines[0].find("device"), std::string::npos) << lines[0];
 }
 
+TEST(StatusReport, CounterLineAndStatusCarryTheEngineAdaptation) {
+  StreamStats s = stream(1, "head", 2000);
+  const auto unknown = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(unknown[0].find("; engine rate not yet measured"), std::string::npos) << unknown[0];
+  EXPECT_EQ(status_line({s}, {}, 1.0).find(" fc "), std::string::npos);
+  s.engine.rate_hz = 285.7;
+  s.engine.window = 128;
+  s.engine.rotation = ChannelAdaptation{true, 0.0012, 3.1, 352.0, 8.2};
+  s.engine.position = ChannelAdaptation{true, 0.0, 0.0, 0.0, 142.85};  // no positions measured
+  const auto lines = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(lines[0].find("; engine 285.7 Hz, window 128, rotation adapted: noise 0.0012 rad, motion 3.1 rad/s^m, cutoff 8.2 Hz "
+                          "(mu 352)"),
+            std::string::npos)
+      << lines[0];
+  EXPECT_EQ(lines[0].find("position"), std::string::npos) << lines[0];
+  EXPECT_NE(status_line({s}, {}, 1.0).find(" fc 8.2Hz (adapted)"), std::string::npos) << status_line({s}, {}, 1.0);
+  s.engine.rotation = ChannelAdaptation{false, 0.0, 0.0, 100.0, 5.0};
+  s.engine.position = ChannelAdaptation{true, 2.5, 40.0, 12.0, 9.0};
+  const auto fixed = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(fixed[0].find(", rotation fixed: cutoff 5 Hz (mu 100), position adapted: noise 2.5 units"), std::string::npos) << fixed[0];
+}
+
 TEST(StatusReport, CounterLineCarriesEveryDeviceCounter) {
   StreamStats s = stream(1, "head", 2000);
   s.device = link(true);

@@ -114,13 +114,14 @@ TEST(FairingWindowAccuracy, GaussNewtonHasConvergedAfterThreeIterations) {
 }
 
 TEST(FairingWindowAccuracy, PositionsAreSolvedIdenticallyByLinearAndGaussNewton) {
-  // Positions are linear: both solvers solve the same banded system exactly.
+  // Positions are linear: both solvers solve the same banded system exactly (the linear
+  // solver as z_k + Σ h_j Δz_j, so they agree to rounding: ~1e-11 of positions of ~400).
   const auto motion = noisy_motion(7, true, 300, 0.02, 10.0);
   const auto in = samples_from(motion.noisy);
   const auto linear = run(smoothing_config(WindowSolver::Linear, 3, 2), in);
   const auto gn = run(smoothing_config(WindowSolver::GaussNewton, 3, 2), in);
   ASSERT_EQ(linear.size(), gn.size());
-  for (std::size_t i = 0; i < linear.size(); ++i) EXPECT_LT((linear[i].position - gn[i].position).norm(), 1e-9) << i;
+  for (std::size_t i = 0; i < linear.size(); ++i) EXPECT_LT((linear[i].position - gn[i].position).norm(), 1e-8) << i;
 }
 
 // Noiseless input the order-m energy does not penalise: W^m = 0 (and D^m p = 0).

@@ -65,6 +65,8 @@ struct Case {
   const char* name;
   WindowSolver solver;
   BoundPolicy bound;
+  bool defaults = false;  // the engine's defaults: the rate is measured, and W, the rows and
+                          // the adaptation are set, inside the measured run
 };
 
 TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
@@ -74,6 +76,7 @@ TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
       {"gauss-newton window bound", WindowSolver::GaussNewton, BoundPolicy::Window},
       {"sweeps", WindowSolver::DampedSweeps, BoundPolicy::Sample},
       {"sweeps window bound", WindowSolver::DampedSweeps, BoundPolicy::Window},
+      {"defaults (adaptive)", WindowSolver::Linear, BoundPolicy::Sample, true},
   };
   constexpr std::size_t kWarmUp = 300, kMeasured = 10000;
   for (const Case& c : cases) {
@@ -88,6 +91,7 @@ TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
     config.continuity = 0.5;
     config.smoothing_r = smoothing_for_cutoff(4.0, 100.0, 3);
     config.smoothing_t = config.smoothing_r;
+    if (c.defaults) config = WindowConfig{};
     config.epsilon_r = 0.02;  // tight enough that the projections run
     config.epsilon_t = 4.0;
     FairingWindow w(config);
@@ -95,7 +99,7 @@ TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
     EXPECT_GT(bytes, 0u);
 
     // Everything the measured loop touches exists before it starts.
-    const std::vector<Sample> warm = stream(kWarmUp, 0.0, 1);
+    const std::vector<Sample> warm = stream(c.defaults ? 3 : kWarmUp, 0.0, 1);
     std::vector<Sample> measured = stream(kMeasured, warm.back().time + 0.01, 2);
     for (std::size_t i = 4000; i < measured.size(); ++i) measured[i].time += 1.0;  // a gap: restart
     Sample bad = measured[5000];
@@ -122,7 +126,8 @@ TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
     EXPECT_EQ(w.memory_bytes(), bytes);
     // The run did what it was meant to: everything emitted once, one gap restart, a rejection,
     // and the bound was exercised.
-    EXPECT_EQ(emitted, kWarmUp + kMeasured);
+    EXPECT_EQ(emitted, warm.size() + kMeasured);
+    if (c.defaults) EXPECT_GT(w.state().rate_hz, 0.0) << "the rate was never measured";
     EXPECT_EQ(w.counters().restarts, 1u);
     EXPECT_EQ(w.gate_counters().rejected_non_unit, 1u);
     EXPECT_GT(w.counters().clamped, 0u);
@@ -175,6 +180,7 @@ TEST(WindowAllocation, MemoryBytesAccountsForTheHeapTheWindowHolds) {
       c.continuity = cs.continuity;
       c.window = window;
       c.lag = 2;
+      if (cs.continuity > 0.0 || cs.solver == WindowSolver::GaussNewton) c.smoothing_r = c.smoothing_t = 100.0;
       const Held h = held_by(c);
       SCOPED_TRACE("solver " + std::to_string(static_cast<int>(cs.solver)) + " continuity " + std::to_string(cs.continuity) +
                    " window " + std::to_string(window));
@@ -182,6 +188,10 @@ TEST(WindowAllocation, MemoryBytesAccountsForTheHeapTheWindowHolds) {
       EXPECT_LE(static_cast<std::ptrdiff_t>(h.reported), h.heap + h.heap / 10);
     }
   }
+  // The defaults: storage for max_window samples and every smoothing level.
+  const Held h = held_by(WindowConfig{});
+  EXPECT_GE(static_cast<std::ptrdiff_t>(h.reported), h.heap);
+  EXPECT_LE(static_cast<std::ptrdiff_t>(h.reported), h.heap + h.heap / 10);
 }
 
 }  // namespace

@@ -74,8 +74,11 @@ TEST(WindowConfig, BoundaryValuesAreValid) {
   ok[4].lambda_r = 1.0;
   ok[4].lambda_t = 1.0;
   ok[5].solver = WindowSolver::GaussNewton;
+  ok[5].window = 32;  // the iterative solvers take W in samples and a fixed μ
+  ok[5].smoothing_r = 100.0;
   ok[5].bound = BoundPolicy::Window;
   ok[6].solver = WindowSolver::DampedSweeps;
+  ok[6].window = 32;
   ok[6].bound = BoundPolicy::Window;
   ok[6].epsilon_r = 1e-9;
   ok[6].epsilon_t = 1e-9;
@@ -91,7 +94,7 @@ TEST(WindowConfig, AContinuityThatMakesTheOutputRecursionUnstableIsRefused) {
   c.order = 3;
   c.window = 32;
   c.lag = 0;
-  c.smoothing_r = 100.0;
+  c.smoothing_r = c.smoothing_t = 100.0;
   c.continuity = 10.0;
   for (WindowSolver solver : {WindowSolver::Linear, WindowSolver::GaussNewton}) {
     c.solver = solver;

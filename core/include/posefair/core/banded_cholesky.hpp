@@ -18,6 +18,11 @@ class BandedCholesky {
   BandedCholesky(int n, int bandwidth);
 
   int size() const { return n_; }
+  // Largest size this object's storage holds (reshape() below it never allocates).
+  int capacity() const { return b_ + 1 > 0 ? static_cast<int>(band_.size()) / (b_ + 1) : 0; }
+  // Makes the matrix n×n (n ≤ capacity()) and all zero, keeping the storage: for systems
+  // built again at run time without allocating.
+  void reshape(int n);
   int bandwidth() const { return b_; }
   // The lower triangle of A before factor(); of L after it. Requires 0 ≤ i-j ≤ bandwidth.
   double& at(int i, int j) { return band_[static_cast<std::size_t>(i * (b_ + 1) + (i - j))]; }
@@ -37,5 +42,9 @@ class BandedCholesky {
 // D^m the forward difference operator of eq. 8 (n-m rows). Factored and ready to solve.
 // Throws std::invalid_argument if the result is not positive definite (some d_i ≤ 0 and μ = 0).
 BandedCholesky make_smoothing_system(int n, int m, double mu, std::span<const double> diagonal);
+
+// The same system assembled and factored in a's storage (a.bandwidth() == m, n ≤ a.capacity()),
+// without allocating. Returns false if it is not positive definite.
+bool assemble_smoothing_system(BandedCholesky& a, int n, int m, double mu, std::span<const double> diagonal);
 
 }  // namespace posefair

@@ -16,6 +16,7 @@ struct CausalResult {
   std::vector<bool> emitted;     // false where the engine dropped or rejected the sample
   WindowCounters counters;
   GateCounters gate;
+  EngineState state;             // the engine's rate, window and adaptation at the end
   double max_dist_r = 0.0;       // max dist(output, input) on S³ over emitted samples
   double max_deviation_t = 0.0;
 };

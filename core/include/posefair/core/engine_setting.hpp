@@ -9,6 +9,10 @@ namespace posefair {
 enum class EngineSetting {
   Window,
   Lag,
+  Horizon,
+  Rate,
+  Cutoff,
+  Adaptation,
   Order,
   Solver,
   Iterations,

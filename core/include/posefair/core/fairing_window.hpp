@@ -22,8 +22,10 @@
 // ε-ball either at emission only (BoundPolicy::Sample) or for every window sample after every
 // iteration (BoundPolicy::Window), and checked in the distance the promise is stated in.
 // Memory is fixed at construction; push() and flush() never allocate.
+#include <array>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -31,20 +33,31 @@
 #include "posefair/core/fairing_operators.hpp"
 #include "posefair/core/sample.hpp"
 #include "posefair/core/sample_gate.hpp"
+#include "posefair/core/smoother_rows.hpp"
+#include "posefair/core/smoothing_adaptation.hpp"
 
 namespace posefair {
 
 enum class WindowSolver { Linear, GaussNewton, DampedSweeps };
 enum class BoundPolicy { Sample, Window };
 
+// The defaults are the engine's, the CLI's and the daemon's alike (docs/engine.md): a window of
+// half a second at the stream's rate, order 2, no lag, and smoothing adapted to the stream's
+// own noise and motion. A setting given in samples or as μ is used exactly as given.
 struct WindowConfig {
-  int window = 32;                 // W samples
+  int window = 0;                  // W samples; 0: window_s at the stream's rate
+  double window_s = 0.5;           // the window as a time span (when window is 0)
+  int max_window = 128;            // the largest W that window_s may give (cost and memory grow with W)
   int lag = 0;                     // L: emit the sample L places behind the newest (0 ≤ L < W)
+  double horizon_s = 0.0;          // > 0: emit the pose predicted this far past the newest sample
   int order = 2;                   // m ∈ {2, 3}
   WindowSolver solver = WindowSolver::Linear;
   int iterations = 1;              // Gauss–Newton iterations, or damped sweeps K, per sample
-  double smoothing_r = 100.0;      // μ_r (Linear, GaussNewton); see smoothing_for_cutoff()
-  double smoothing_t = 100.0;      // μ_t (Linear, GaussNewton)
+  std::optional<double> smoothing_r;  // μ_r; unset: from cutoff_hz, else adapted (Linear only)
+  std::optional<double> smoothing_t;  // μ_t, the same for positions
+  std::optional<double> cutoff_hz;    // μ from this cutoff (Hz) at the stream's rate; see smoothing_for_cutoff()
+  double rate_hz = 0.0;            // the stream's rate; 0: measured from its first intervals
+  AdaptationSettings adaptation;   // when smoothing is adapted
   double continuity = 0.0;         // κ (Linear, GaussNewton)
   double lambda_r = 0.1;           // DampedSweeps
   double lambda_t = 0.5;           // DampedSweeps
@@ -57,6 +70,11 @@ struct WindowConfig {
 
 // Largest accepted smoothing weight μ (see validate()).
 inline constexpr double kMaxSmoothing = 1e10;
+// The shortest window window_s may give, and the intervals that measure an unknown rate.
+inline constexpr int kMinWindowSamples = 8;
+inline constexpr int kRateIntervals = 8;
+// Candidate smoothing levels of the adaptation (a third of an octave of cutoff apart).
+inline constexpr int kMaxSmoothingLevels = 28;
 
 // Throws InvalidEngineSetting (core/engine_setting.hpp, a std::invalid_argument) naming the
 // field and its valid range, and the field as setting(). The constructor also
@@ -66,11 +84,28 @@ void validate(const WindowConfig& config);
 // μ for which the steady-state Whittaker smoother I + μ(D^m)ᵀD^m has gain 1/2 (−6 dB) at
 // cutoff_hz for samples at rate_hz: μ = (2 sin(π f_c / f_s))^(−2m).
 double smoothing_for_cutoff(double cutoff_hz, double rate_hz, int order);
+// Its inverse: the cutoff (Hz) of μ at rate_hz.
+double cutoff_for_smoothing(double mu, double rate_hz, int order);
 
 struct WindowCounters {
   std::uint64_t emitted = 0;
   std::uint64_t clamped = 0;    // emitted poses the ε projection had to move
   std::uint64_t restarts = 0;   // windows restarted after a gap
+};
+
+// What the engine is doing now: the rate and window it settled on and, per channel, what the
+// adaptation measured and chose (or the fixed smoothing). For counters and STATUS=.
+struct ChannelAdaptation {
+  bool adaptive = false;
+  double noise = 0.0;      // RMS measurement noise per sample (rad of rotation angle, or position units)
+  double motion = 0.0;     // RMS m-th time derivative of the motion (rad/s^m, or units/s^m)
+  double smoothing = 0.0;  // μ in use
+  double cutoff_hz = 0.0;  // the cutoff μ corresponds to at the rate (0 while the rate is unknown)
+};
+struct EngineState {
+  double rate_hz = 0.0;    // given or measured; 0 until known
+  int window = 0;          // W in use
+  ChannelAdaptation rotation, position;
 };
 
 class FairingWindow {
@@ -90,17 +125,34 @@ class FairingWindow {
   const WindowCounters& counters() const { return counters_; }
   const GateCounters& gate_counters() const { return gate_.counters(); }
   const WindowConfig& config() const { return config_; }
+  EngineState state() const;
   int size() const { return n_; }
   // Bytes held for this stream (all of it allocated at construction).
   std::size_t memory_bytes() const;
 
  private:
+  // One half of the linear solver's state: rotation (ζ = log(z_j⁻¹ z_{j+1})) or position
+  // (ζ = p_{j+1} − p_j), which share the emission rows but choose their smoothing apart.
+  struct Channel {
+    Channel(int capacity, int order);
+    bool adaptive = true;
+    double mu = 0.0;            // fixed μ, or the adapted one
+    double level = 0.0;         // adapted: real index into levels_
+    EmissionRow fixed;          // fixed μ: the full window's row
+    MotionNoiseEstimator estimator;
+  };
+
   void append(const Sample& s);
-  void solve();
-  void linear_rotation(const BandedCholesky& a);
-  void linear_emission_estimate(int k);
-  void precompute_linear_rows();
+  void note_interval(double dt);
+  bool needs_rate() const;
+  void prepare(double rate_hz);
+  void slide(int count);
+  void adapt(Channel& ch, std::span<const Vec3> zeta, double dt);
+  Vec3 linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c);
+  void linear_emission_estimate(int k, double dt);
   void check_continuity_stability() const;
+  void solve();
+  void linear_window();
   void gauss_newton_rotation(const BandedCholesky& a);
   void smoothness_gradient(std::span<const Vec3> w1);
   void solve_positions(const BandedCholesky& a);
@@ -113,10 +165,28 @@ class FairingWindow {
   WindowConfig config_;
   SampleGate gate_;
   WindowCounters counters_;
+  int capacity_ = 0;       // storage, in samples
+  int w_ = 0;              // W in use (capacity_ until the rate is known)
   int n_ = 0;              // samples in the window
   bool positions_ = false; // this window carries positions (all its samples do)
   bool have_emitted_ = false;
   Quat last_emitted_ = Quat::Identity();
+  double last_time_ = 0.0;
+  bool have_time_ = false;
+
+  // The rate: given, or the median of the first kRateIntervals intervals.
+  double rate_ = 0.0;
+  bool prepared_ = false;  // W, the rows and the estimators are set for rate_
+  std::array<double, kRateIntervals> intervals_{};
+  int interval_count_ = 0;
+
+  // Linear solver.
+  EmissionTarget target_spec_;
+  EmissionRowBuilder builder_;
+  std::vector<EmissionRow> levels_;  // candidate rows for the adaptation, least smoothing first
+  int level_count_ = 0;
+  EmissionRow fill_row_;             // scratch: the row of a window still filling
+  Channel rot_, pos_;
 
   // Per sample, index 0 = oldest.
   std::vector<Sample> samples_;   // as accepted (time, ids, measured values with their own sign)
@@ -125,19 +195,17 @@ class FairingWindow {
   std::vector<Vec3> zeta_;        // ζ_j = log(z_j⁻¹ z_{j+1}) (Linear)
   std::vector<Vec3> est_;         // e_i: estimate x_i = z_i exp(e_i) (Linear)
   std::vector<Vec3> c_;           // log(z_i⁻¹ y_i) of emitted samples (Linear)
+  std::vector<Vec3> dzp_;         // p_{j+1} − p_j (Linear)
+  std::vector<Vec3> cp_;          // y_p,i − z_p,i of emitted samples (Linear)
   std::vector<char> window_clamped_;  // the window bound moved this sample during a solve
   std::vector<Quat> y_;           // what was emitted (valid for emitted indices)
   std::vector<Vec3> zp_, xp_, yp_;
   // Scratch.
-  std::vector<Vec3> e_, u_, w_, rhs_;
+  std::vector<Vec3> e_, u_, w_scratch_, rhs_;
   std::vector<Quat> target_;
   std::vector<double> diag_;
-  // factors_r_[n], factors_t_[n]: the system for a window holding n samples.
+  // Iterative solvers: factors_r_[n], factors_t_[n], the system for a window holding n samples.
   std::vector<BandedCholesky> factors_r_, factors_t_;
-  // Linear: the emitted sample's estimate is a fixed linear function of the window, so its
-  // coefficients are precomputed per fill level n (row_zeta_[n]: n-1 weights on ζ, row_c_[n]:
-  // n weights on c, row_p_[n]: n weights on z_p + κ y_p). One dot product per sample.
-  std::vector<std::vector<double>> row_zeta_, row_c_, row_p_;
 };
 
 }  // namespace posefair

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "posefair/core/fairing_window.hpp"
 #include "posefair/daemon/latency_histogram.hpp"
 #include "posefair/drivers/driver.hpp"
 #include "posefair/drivers/gpio_data_ready.hpp"
@@ -30,6 +31,15 @@ struct StreamCounters {
   std::atomic<std::uint64_t> send_failures{0};    // failed sends (one per destination)
   std::atomic<std::uint64_t> recorded{0};         // handed to the recorder's writer
   LatencyHistogram latency;                       // hand-over → last datagram of the pose sent
+  // The engine's state (FairingWindow::state()): the rate and window it settled on, and what
+  // its adaptation measured and chose. Written by the engine thread after each batch.
+  struct Channel {
+    std::atomic<bool> adaptive{false};
+    std::atomic<double> noise{0.0}, motion{0.0}, smoothing{0.0}, cutoff_hz{0.0};
+  };
+  std::atomic<double> engine_rate_hz{0.0};
+  std::atomic<int> engine_window{0};
+  Channel rotation, position;
 };
 
 // A consistent-enough copy for reporting (each field read once, relaxed).
@@ -41,6 +51,7 @@ struct StreamStats {
   std::uint64_t received = 0, ring_dropped = 0, rejected = 0, out_of_order = 0, emitted = 0, clamped = 0, restarts = 0;
   std::uint64_t publish_dropped = 0, published = 0, send_failures = 0, recorded = 0, record_dropped = 0;
   HistogramSnapshot latency;
+  EngineState engine;      // rate, window, and the adaptation's noise, motion and cutoff
   bool bridging = false, resampling = false;  // [stream.spline] parts configured
   std::uint64_t bridged_gaps = 0, bridged_samples = 0, resampled = 0;
   bool matrix_lerp = false;  // [stream.spline] pose_interpolation = "matrix-lerp"

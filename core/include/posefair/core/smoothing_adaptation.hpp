@@ -1,0 +1,82 @@
+#pragma once
+// How much to smooth, estimated from the stream itself (the engine's default).
+//
+// The window smoother with weight μ trades noise for lag: its emitted value has noise variance
+// σ²·G(μ) and, where the motion's m-th difference is d, a bias d·B(μ) (smoother_rows.hpp). Both
+// G and B are known exactly for every candidate μ; what the stream must supply is σ² and d²:
+//   noise σ²: from the (m+2)-th differences of the measurements, which smooth motion hardly
+//     reaches and white noise fills with variance C(2m+4, m+2)·σ² per component. Robustly:
+//     the median of their length (a χ with 3 degrees of freedom), tracked in log space, so
+//     that outliers and short bursts of fast motion do not move it.
+//   motion d²: the m-th derivative of a local polynomial fit (Savitzky–Golay, degree m, at
+//     the centre of a short span), squared, averaged over a short time, minus the noise the
+//     fit lets through (σ² times the sum of its squared weights, known exactly). Motion
+//     below that noise cannot be told from none, so the estimate never goes below it: a
+//     stream that only seems still is not smoothed without limit.
+// The chosen μ minimises the expected squared error σ²G(μ) + d²B(μ)², the balance One Euro
+// strikes by hand with β: fast motion gets little smoothing (no lag, no clamping), slow motion
+// a lot. Every input is per sample; the time constants are in seconds, so streams of any rate
+// behave alike. No allocation after construction.
+#include <array>
+#include <span>
+#include <vector>
+
+#include "posefair/core/smoother_rows.hpp"
+#include "posefair/core/so3.hpp"
+
+namespace posefair {
+
+struct AdaptationSettings {
+  double noise_time_s = 2.0;   // how fast the noise estimate follows a change of noise
+  double motion_time_s = 0.1;  // how fast the motion estimate follows the motion
+  double motion_span_s = 0.25; // span of the local fit that measures the motion
+  // The motion counts this many times in the expected error. A fit over motion_span_s sees
+  // only the motion's slower part, and smoothing too hard costs lag that the output never
+  // makes up, while smoothing too little costs only the noise it leaves: so err light.
+  double motion_margin = 2.0;
+};
+
+// Noise and motion of one channel (rotation or position), from its differences ζ.
+class MotionNoiseEstimator {
+ public:
+  MotionNoiseEstimator(int capacity, int order);
+
+  // Sets the fit's span for this rate (at least order + 3 samples, at most capacity) and
+  // forgets nothing else.
+  void configure(double rate_hz, const AdaptationSettings& settings);
+
+  // After a new sample: zeta holds the window's n−1 differences, newest last; dt is the
+  // newest step (seconds). Differences across a window restart are never used.
+  void update(std::span<const Vec3> zeta, double dt);
+
+  bool ready() const { return noise_count_ > 0 && motion_ready_; }
+  double noise_variance() const { return noise_var_; }    // σ², per component, per sample
+  double motion_variance() const { return motion_var_; }  // d², per component, per sample^(2m)
+  int span() const { return span_; }
+
+ private:
+  void update_noise(double length, double dt);
+
+  int order_;
+  int capacity_;
+  AdaptationSettings settings_;
+  int span_ = 0;
+  std::vector<double> fit_;      // weights on the span's span−1 differences
+  double fit_noise_gain_ = 0.0;  // Σ of the fit's squared weights on θ
+  // Noise: the median of ‖D^{m+2}θ‖, exact over the first values, then tracked.
+  std::array<double, 15> first_lengths_{};
+  int noise_count_ = 0;
+  double log_median_ = 0.0;
+  double noise_var_ = 0.0;
+  // Motion.
+  double mean_square_ = 0.0;
+  bool motion_ready_ = false;
+  double motion_var_ = 0.0;
+};
+
+// The smoothing level (a real index into rows, ordered from least to most smoothing) with the
+// smallest expected squared error σ²·G + d²·B², refined between neighbours by a parabola in
+// the level index.
+double best_level(std::span<const EmissionRow> rows, int count, double noise_var, double motion_var);
+
+}  // namespace posefair

@@ -1,0 +1,133 @@
+#include "posefair/core/smoothing_adaptation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+namespace posefair {
+namespace {
+
+double binomial(int n, int k) {
+  double b = 1.0;
+  for (int j = 1; j <= k; ++j) b = b * (n - k + j) / j;
+  return b;
+}
+
+// Median of the χ distribution with 3 degrees of freedom: the length of a 3-vector of unit
+// normal components is below this half of the time.
+constexpr double kChi3Median = 1.5381722;
+
+}  // namespace
+
+MotionNoiseEstimator::MotionNoiseEstimator(int capacity, int order)
+    : order_(order), capacity_(capacity), fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0) {}
+
+void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& settings) {
+  settings_ = settings;
+  const int m = order_;
+  span_ = std::clamp(static_cast<int>(std::lround(settings.motion_span_s * rate_hz)), m + 3, std::max(m + 3, capacity_));
+  span_ = std::min(span_, capacity_);
+  // Least-squares polynomial of degree m through the span, its m-th derivative at the centre:
+  // w_i = m!·[(XᵀX)⁻¹Xᵀ]_{m,i}, X_{iq} = (i − c)^q. At most 4×4 (m ≤ 3): fixed size, no heap.
+  const double c = 0.5 * (span_ - 1);
+  Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
+  const int q = m + 1;
+  for (int i = 0; i < span_; ++i) {
+    Eigen::Vector4d x = Eigen::Vector4d::Zero();
+    for (int p = 0; p < q; ++p) x(p) = std::pow(i - c, p);
+    normal += x * x.transpose();
+  }
+  for (int p = q; p < 4; ++p) normal(p, p) = 1.0;  // unused powers (m = 2)
+  const Eigen::LDLT<Eigen::Matrix4d> ldlt(normal);
+  Eigen::Vector4d unit = Eigen::Vector4d::Zero();
+  unit(m) = 1.0;
+  const Eigen::Vector4d a = ldlt.solve(unit);  // row m of (XᵀX)⁻¹
+  double factorial = 1.0;
+  for (int p = 2; p <= m; ++p) factorial *= p;
+  // Σ w_i θ_i = −Σ_j W_j ζ_j with W_j = Σ_{i≤j} w_i (the weights sum to zero).
+  double cumulative = 0.0;
+  fit_noise_gain_ = 0.0;
+  for (int i = 0; i < span_; ++i) {
+    double w = 0.0;
+    for (int p = 0; p < q; ++p) w += a(p) * std::pow(i - c, p);
+    w *= factorial;
+    fit_noise_gain_ += w * w;
+    cumulative += w;
+    if (i < span_ - 1) fit_[static_cast<std::size_t>(i)] = -cumulative;
+  }
+}
+
+void MotionNoiseEstimator::update_noise(double length, double dt) {
+  const int k = order_ + 2;
+  const double scale = kChi3Median * std::sqrt(binomial(2 * k, k));  // ‖D^kθ‖ median per unit σ
+  const double floor = 1e-300;
+  length = std::max(length, floor);
+  if (noise_count_ < static_cast<int>(first_lengths_.size())) {
+    // Exact median of the first values: a sound start for the tracker below.
+    first_lengths_[static_cast<std::size_t>(noise_count_++)] = length;
+    std::array<double, 15> sorted = first_lengths_;
+    const auto n = static_cast<std::ptrdiff_t>(noise_count_);
+    std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.begin() + n);
+    log_median_ = std::log(sorted[static_cast<std::size_t>(n / 2)]);
+  } else {
+    // Stochastic approximation of the median in log space: a step up when above, down when
+    // below; its time constant is about 1/(2·step) samples.
+    const double step = std::min(0.5, 0.5 * dt / settings_.noise_time_s);
+    log_median_ += std::log(length) > log_median_ ? step : -step;
+  }
+  const double sigma = std::exp(log_median_) / scale;
+  noise_var_ = sigma * sigma;
+}
+
+void MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
+  const int n1 = static_cast<int>(zeta.size());  // differences available
+  const int k = order_ + 2;
+  if (!(dt > 0.0)) return;
+  if (n1 >= k - 1 + 1) {
+    // D^kθ at the newest = D^{k−1} of the newest k differences.
+    Vec3 d = Vec3::Zero();
+    for (int j = 0; j < k; ++j) {
+      const double sign = ((k - 1 - j) % 2 == 0) ? 1.0 : -1.0;
+      d += sign * binomial(k - 1, j) * zeta[static_cast<std::size_t>(n1 - k + j)];
+    }
+    update_noise(d.norm(), dt);
+  }
+  if (span_ > 0 && n1 >= span_ - 1) {
+    Vec3 d = Vec3::Zero();
+    const auto base = static_cast<std::size_t>(n1 - (span_ - 1));
+    for (int j = 0; j < span_ - 1; ++j) d += fit_[static_cast<std::size_t>(j)] * zeta[base + static_cast<std::size_t>(j)];
+    const double sample = d.squaredNorm() / 3.0;
+    const double alpha = motion_ready_ ? 1.0 - std::exp(-dt / settings_.motion_time_s) : 1.0;
+    mean_square_ += alpha * (sample - mean_square_);
+    motion_ready_ = true;
+  }
+  if (motion_ready_) {
+    const double fit_noise = noise_var_ * fit_noise_gain_;
+    motion_var_ = std::max(fit_noise, mean_square_ - fit_noise);
+  }
+}
+
+double best_level(std::span<const EmissionRow> rows, int count, double noise_var, double motion_var) {
+  if (count <= 1) return 0.0;
+  auto cost = [&](int l) {
+    const EmissionRow& r = rows[static_cast<std::size_t>(l)];
+    return noise_var * r.noise_gain + motion_var * r.bias * r.bias;
+  };
+  int best = 0;
+  double best_cost = cost(0);
+  for (int l = 1; l < count; ++l) {
+    const double c = cost(l);
+    if (c < best_cost) {
+      best_cost = c;
+      best = l;
+    }
+  }
+  if (best == 0 || best == count - 1) return best;
+  const double a = cost(best - 1), b = best_cost, c = cost(best + 1);
+  const double curvature = a - 2.0 * b + c;
+  if (!(curvature > 0.0)) return best;
+  return best + std::clamp(0.5 * (a - c) / curvature, -0.5, 0.5);
+}
+
+}  // namespace posefair
