@@ -1,0 +1,298 @@
+// The engine's defaults: rate independence, the adaptation's estimates and choices, the
+// emission rows' error model, and prediction (docs/engine.md, "Defaults and adaptation").
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "engine_test_support.hpp"
+#include "posefair/core/causal_fairing.hpp"
+#include "posefair/core/fairing_window.hpp"
+#include "posefair/core/quality_metrics.hpp"
+#include "posefair/core/smoother_rows.hpp"
+
+namespace posefair {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
+
+// A smooth motion given as a function of time (rotation vector, physical radians), so it can
+// be sampled at any rate: slow sines on three axes, `speed` scaling their frequencies.
+Vec3 motion_vector(double t, double speed) {
+  return Vec3(0.8 * std::sin(2.0 * std::numbers::pi * 0.35 * speed * t), 0.5 * std::sin(2.0 * std::numbers::pi * 0.6 * speed * t + 1.0),
+              0.6 * std::sin(2.0 * std::numbers::pi * 0.45 * speed * t + 2.0));
+}
+Quat motion_at(double t, double speed = 1.0) { return so3::from_rotation_vector(motion_vector(t, speed)); }
+
+struct Stream {
+  PoseSequence input;
+  std::vector<Quat> truth;
+};
+
+// `seconds` of the motion at `rate`, each sample turned by a Gaussian rotation of `sigma`
+// per axis (physical angle).
+Stream sampled(double rate, double seconds, double sigma, double speed = 1.0, std::uint64_t seed = 3) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  Stream s;
+  const auto n = static_cast<std::size_t>(std::lround(seconds * rate));
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / rate;
+    const Quat q = motion_at(t, speed);
+    const Vec3 d(noise(rng), noise(rng), noise(rng));
+    s.input.time.push_back(t);
+    s.input.orientation.push_back(q * so3::from_rotation_vector(sigma * d));
+    s.truth.push_back(q);
+  }
+  return s;
+}
+
+double rms_error(const std::vector<Quat>& out, const std::vector<Quat>& truth, std::size_t skip) {
+  std::vector<char> use(out.size(), 1);
+  for (std::size_t i = 0; i < skip && i < use.size(); ++i) use[i] = 0;
+  return rotation_error(out, truth, use).rms;
+}
+
+TEST(RateIndependence, AFixedCutoffGivesTheSameOutputAtEveryRate) {
+  // No noise, a low cutoff: each output lags its truth by the smoother's bias, which depends
+  // on the cutoff in Hz and the window in seconds, not on the rate. (μ fixed in samples, the
+  // engine's old default, makes that bias grow a hundredfold from 10 Hz to 1 kHz.)
+  const double rates[] = {25.0, 50.0, 100.0, 200.0, 400.0};
+  std::vector<std::vector<Quat>> outputs;
+  for (double rate : rates) {
+    WindowConfig c;
+    c.cutoff_hz = 2.0;
+    c.max_window = 512;  // 0.5 s at every rate here
+    const Stream s = sampled(rate, 6.0, 0.0);
+    outputs.push_back(fair_causal(s.input, c).poses.orientation);
+  }
+  const std::vector<Quat>& reference = outputs.back();  // 400 Hz
+  double bias = 0.0;
+  std::vector<double> worst(std::size(rates) - 1, 0.0);
+  for (std::size_t r = 0; r + 1 < std::size(rates); ++r) {
+    // Common times: every 40 ms from 2 s on (every rate has a sample there).
+    for (int k = 50; k < 150; ++k) {
+      const double t = 0.04 * k;
+      const auto i = static_cast<std::size_t>(std::lround(t * rates[r]));
+      const auto j = static_cast<std::size_t>(std::lround(t * rates[std::size(rates) - 1]));
+      worst[r] = std::max(worst[r], so3::rotation_angle(outputs[r][i], reference[j]));
+      bias = std::max(bias, so3::rotation_angle(reference[j], motion_at(t)));
+    }
+  }
+  EXPECT_GT(bias, 0.01) << "the case must have a visible lag to compare";
+  // The discrete smoother approaches its continuous limit as the rate rises (the difference
+  // halves with each doubling); at 12 samples per cutoff period it is within a third of the lag.
+  EXPECT_LT(worst[0], 0.35 * bias) << "25 Hz";
+  for (std::size_t r = 1; r < worst.size(); ++r) {
+    EXPECT_LT(worst[r], 0.15 * bias) << rates[r] << " Hz differs by " << worst[r] << " rad; the lag is " << bias;
+    EXPECT_LT(worst[r], 0.7 * worst[r - 1]) << rates[r] << " Hz";
+  }
+}
+
+TEST(RateIndependence, TheDefaultsAgreeAcrossRatesOnTheSameNoiseDensity) {
+  // White noise of one spectral density (σ² / rate constant): the physically same stream
+  // sampled at four rates. The defaults must settle on the same cutoff and window span, and
+  // do as well as the best fixed cutoff for each rate. (The errors themselves differ: a causal
+  // smoother passes some of the noise up to Nyquist, and a faster stream has more of it.)
+  const double rates[] = {30.0, 60.0, 120.0, 240.0};
+  std::vector<double> cutoffs, errors, spans;
+  for (double rate : rates) {
+    const double sigma = 0.004 * std::sqrt(rate / 30.0);
+    const Stream s = sampled(rate, 12.0, sigma);
+    WindowConfig c;
+    const CausalResult r = fair_causal(s.input, c);
+    cutoffs.push_back(r.state.rotation.cutoff_hz);
+    spans.push_back(r.state.window / r.state.rate_hz);
+    errors.push_back(rms_error(r.poses.orientation, s.truth, static_cast<std::size_t>(2.0 * rate)));
+    EXPECT_NEAR(r.state.rate_hz, rate, 1e-6 * rate);
+    EXPECT_LT(errors.back(), rms_error(s.input.orientation, s.truth, 0)) << rate << " Hz: no gain over the raw stream";
+    // As good as the best fixed cutoff for this rate (a grid a third of an octave apart).
+    double best = 1e9;
+    for (double fc = 2.0; fc < 0.4 * rate; fc *= std::pow(2.0, 1.0 / 3.0)) {
+      WindowConfig f;
+      f.cutoff_hz = fc;
+      best = std::min(best, rms_error(fair_causal(s.input, f).poses.orientation, s.truth, static_cast<std::size_t>(2.0 * rate)));
+    }
+    EXPECT_LT(errors.back(), 1.05 * best) << rate << " Hz";
+  }
+  for (std::size_t i = 1; i < cutoffs.size(); ++i) {
+    EXPECT_NEAR(spans[i], 0.5, 0.01) << rates[i];
+    EXPECT_LT(std::abs(std::log(cutoffs[i] / cutoffs[0])), std::log(1.5)) << rates[i] << " Hz: cutoff " << cutoffs[i] << " vs " << cutoffs[0];
+  }
+}
+
+TEST(Adaptation, EstimatesTheNoiseOfTheStream) {
+  for (double sigma : {0.001, 0.005, 0.02}) {
+    const Stream s = sampled(200.0, 10.0, sigma);
+    const CausalResult r = fair_causal(s.input, WindowConfig{});
+    ASSERT_TRUE(r.state.rotation.adaptive);
+    // Reported as the RMS rotation angle of the noise: σ per axis, √3 σ in all.
+    EXPECT_NEAR(r.state.rotation.noise, std::sqrt(3.0) * sigma, 0.15 * std::sqrt(3.0) * sigma) << sigma;
+  }
+}
+
+TEST(Adaptation, FastMotionIsSmoothedLessAndClampedLessThanSlowMotion) {
+  const double sigma = 0.005;
+  double cutoff[2] = {};
+  std::uint64_t clamped[2] = {};
+  for (int fast = 0; fast < 2; ++fast) {
+    const Stream s = sampled(200.0, 10.0, sigma, fast ? 4.0 : 0.5);
+    WindowConfig c;
+    c.epsilon_r = 3.0 * sigma / 2.0;  // dist on S³: a bound of 3σ of rotation angle
+    const CausalResult r = fair_causal(s.input, c);
+    cutoff[fast] = r.state.rotation.cutoff_hz;
+    clamped[fast] = r.counters.clamped;
+    EXPECT_LE(r.max_dist_r, c.epsilon_r) << "the bound holds under adaptation";
+    EXPECT_LT(rms_error(r.poses.orientation, s.truth, 400), rms_error(s.input.orientation, s.truth, 400)) << fast;
+    EXPECT_LT(static_cast<double>(clamped[fast]), 0.05 * static_cast<double>(s.input.size())) << fast;
+  }
+  EXPECT_GT(cutoff[1], 2.0 * cutoff[0]) << "slow " << cutoff[0] << " Hz, fast " << cutoff[1] << " Hz";
+}
+
+TEST(Adaptation, ANoiseFreeStreamPassesUnchanged) {
+  const Stream s = sampled(100.0, 5.0, 0.0);
+  const CausalResult r = fair_causal(s.input, WindowConfig{});
+  EXPECT_LT(rms_error(r.poses.orientation, s.truth, 0), 1e-6);
+}
+
+TEST(Adaptation, AGivenSmoothingOrCutoffIsUsedExactly) {
+  const Stream s = sampled(100.0, 3.0, 0.01);
+  WindowConfig c;
+  c.smoothing_r = 37.5;
+  CausalResult r = fair_causal(s.input, c);
+  EXPECT_FALSE(r.state.rotation.adaptive);
+  EXPECT_EQ(r.state.rotation.smoothing, 37.5);
+  c = WindowConfig{};
+  c.cutoff_hz = 6.0;
+  c.rate_hz = 100.0;
+  r = fair_causal(s.input, c);
+  EXPECT_FALSE(r.state.rotation.adaptive);
+  EXPECT_DOUBLE_EQ(r.state.rotation.smoothing, smoothing_for_cutoff(6.0, 100.0, 2));
+  EXPECT_NEAR(r.state.rotation.cutoff_hz, 6.0, 1e-9);
+  // The same cutoff with the rate measured from the stream: the same μ (the stream is regular).
+  c.rate_hz = 0.0;
+  r = fair_causal(s.input, c);
+  EXPECT_NEAR(r.state.rotation.smoothing, smoothing_for_cutoff(6.0, 100.0, 2), 1e-6 * r.state.rotation.smoothing);
+}
+
+TEST(Adaptation, TheRateIsMeasuredAndTheWindowIsHalfASecond) {
+  for (double rate : {10.0, 90.0, 200.0, 1000.0}) {
+    const Stream s = sampled(rate, 2.0, 0.001);
+    const CausalResult r = fair_causal(s.input, WindowConfig{});
+    EXPECT_NEAR(r.state.rate_hz, rate, 1e-6 * rate);
+    const int expected = std::clamp(static_cast<int>(std::lround(0.5 * rate)), kMinWindowSamples, WindowConfig{}.max_window);
+    EXPECT_EQ(r.state.window, expected) << rate;
+  }
+}
+
+TEST(EmissionRows, TheirBiasAndNoiseGainPredictTheEngine) {
+  // Positions are linear, so the rows' error model is exact for them: a constant
+  // acceleration a gives the error a·bias, white noise of variance 1 the variance noise_gain.
+  for (int lag : {0, 3}) {
+    WindowConfig c;
+    c.window = 40;
+    c.lag = lag;
+    c.smoothing_r = c.smoothing_t = 300.0;
+    EmissionRowBuilder builder(40, 2);
+    EmissionRow row = make_emission_row(40);
+    ASSERT_TRUE(builder.build(40, 300.0, EmissionTarget{2, lag, 0.0, 0.0}, row));
+    EXPECT_GT(row.noise_gain, 0.0);
+    EXPECT_LT(row.noise_gain, 1.0);
+    FairingWindow w(c);
+    std::vector<FairedPose> out(static_cast<std::size_t>(w.max_outputs_per_push()));
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> unit(0.0, 1.0);
+    const double a = 0.02;  // position units per sample²
+    double sum_sq = 0.0;
+    std::size_t count = 0;
+    for (int i = 0; i < 20000; ++i) {
+      Sample s;
+      s.sequence = static_cast<std::uint64_t>(i);
+      s.time = 0.01 * i;
+      s.flags = kHasPosition;
+      const bool noisy = i >= 200;
+      s.position = noisy ? Vec3(unit(rng), unit(rng), unit(rng)) : Vec3(0.5 * a * i * i, 0.0, 0.0);
+      const int k = w.push(s, out);
+      for (int j = 0; j < k; ++j) {
+        const FairedPose& f = out[static_cast<std::size_t>(j)];
+        const auto at = static_cast<int>(f.sequence);
+        if (!noisy && at >= 60 && at < 200 - lag - 1)
+          EXPECT_NEAR(f.position.x() - 0.5 * a * at * at, a * row.bias, 1e-7) << "lag " << lag << " sample " << at;
+        if (at >= 300) {
+          sum_sq += f.position.squaredNorm() / 3.0;
+          ++count;
+        }
+      }
+    }
+    EXPECT_NEAR(sum_sq / static_cast<double>(count), row.noise_gain, 0.05 * row.noise_gain) << "lag " << lag;
+  }
+}
+
+TEST(Prediction, ConstantMotionIsPredictedExactlyAndStampedWithItsTime) {
+  // About one axis rotations commute, so the linearised extrapolation is exact: m = 2 for a
+  // constant angular velocity, m = 3 for a constant angular acceleration.
+  for (int m : {2, 3}) {
+    for (bool adapted : {true, false}) {
+      WindowConfig c;
+      c.order = m;
+      c.horizon_s = 0.02;
+      if (!adapted) c.smoothing_r = 50.0;
+      FairingWindow w(c);
+      std::vector<FairedPose> out(1);
+      auto angle = [m](double t) { return m == 2 ? 3.0 * t : 1.0 * t + 2.0 * t * t; };
+      const Vec3 axis = Vec3(1.0, 2.0, 2.0).normalized();
+      double worst = 0.0;
+      for (int i = 0; i < 300; ++i) {
+        Sample s;
+        s.sequence = static_cast<std::uint64_t>(i);
+        s.time = 0.005 * i;
+        s.orientation = so3::from_rotation_vector(angle(s.time) * axis);
+        ASSERT_EQ(w.push(s, out), 1);
+        EXPECT_DOUBLE_EQ(out[0].time, s.time + 0.02);
+        if (i >= 150) worst = std::max(worst, so3::rotation_angle(out[0].orientation, so3::from_rotation_vector(angle(s.time + 0.02) * axis)));
+      }
+      EXPECT_LT(worst, 1e-6) << "m=" << m << (adapted ? " adapted" : " fixed");
+    }
+  }
+}
+
+TEST(Prediction, BeatsTheUnpredictedPoseAgainstTheFuture) {
+  const double h = 0.02;
+  const Stream s = sampled(200.0, 10.0, 0.003, 2.0);
+  WindowConfig now, ahead;
+  ahead.horizon_s = h;
+  const auto a = fair_causal(s.input, now).poses.orientation;
+  const auto b = fair_causal(s.input, ahead).poses.orientation;
+  double err_now = 0.0, err_ahead = 0.0;
+  for (std::size_t i = 400; i < s.input.size(); ++i) {
+    const Quat future = motion_at(s.input.time[i] + h, 2.0);
+    err_now += std::pow(so3::rotation_angle(a[i], future), 2);
+    err_ahead += std::pow(so3::rotation_angle(b[i], future), 2);
+  }
+  EXPECT_LT(err_ahead, 0.25 * err_now);
+}
+
+TEST(Prediction, RefusesWhatItCannotHonour) {
+  WindowConfig c;
+  c.horizon_s = 0.02;
+  c.lag = 2;
+  EXPECT_THAT([&] { validate(c); }, ThrowsMessage<std::invalid_argument>(HasSubstr("needs lag 0")));
+  c.lag = 0;
+  c.epsilon_r = 0.01;
+  EXPECT_THAT([&] { validate(c); }, ThrowsMessage<std::invalid_argument>(HasSubstr("epsilon")));
+  c.epsilon_r = std::numeric_limits<double>::infinity();
+  c.solver = WindowSolver::GaussNewton;
+  c.window = 32;
+  c.smoothing_r = 10.0;
+  EXPECT_THAT([&] { validate(c); }, ThrowsMessage<std::invalid_argument>(HasSubstr("linear solver")));
+  c = WindowConfig{};
+  c.horizon_s = 2.0;
+  EXPECT_THAT([&] { validate(c); }, ThrowsMessage<std::invalid_argument>(HasSubstr("horizon")));
+}
+
+}  // namespace
+}  // namespace posefair
