@@ -299,6 +299,18 @@ Vec3 apply_row(const EmissionRow& row, int n, std::span<const Vec3> zeta, std::s
   return e;
 }
 
+// (1 − f)·u_a + f·u_b in one pass over ζ (the adapted smoothing between two levels; no
+// continuity, which needs fixed smoothing).
+Vec3 apply_rows(const EmissionRow& a, const EmissionRow& b, double f, int n, std::span<const Vec3> zeta) {
+  Vec3 e = Vec3::Zero();
+  const int first = std::min(a.first, b.first);
+  for (int j = first; j < n - 1; ++j) {
+    const auto i = static_cast<std::size_t>(j);
+    e += ((1.0 - f) * a.zeta[i] + f * b.zeta[i]) * zeta[i];
+  }
+  return e;
+}
+
 }  // namespace
 
 Vec3 FairingWindow::linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c) {
@@ -309,10 +321,9 @@ Vec3 FairingWindow::linear_correction(Channel& ch, std::span<const Vec3> zeta, s
     if (!ch.adaptive) return apply_row(ch.fixed, n_, zeta, c, emitted, continuity);
     const int i = static_cast<int>(ch.level);
     const double f = ch.level - i;
-    Vec3 e = apply_row(levels_[static_cast<std::size_t>(i)], n_, zeta, c, emitted, continuity);
-    if (f > 0.0 && i + 1 < level_count_)
-      e = (1.0 - f) * e + f * apply_row(levels_[static_cast<std::size_t>(i + 1)], n_, zeta, c, emitted, continuity);
-    return e;
+    const EmissionRow& a = levels_[static_cast<std::size_t>(i)];
+    if (!(f > 0.0) || i + 1 >= level_count_) return apply_row(a, n_, zeta, c, emitted, false);
+    return apply_rows(a, levels_[static_cast<std::size_t>(i + 1)], f, n_, zeta);
   }
   // A window still filling (after the start or a gap): its row, built for this fill level.
   if (ch.mu == 0.0 && config_.horizon_s == 0.0) return Vec3::Zero();

@@ -59,12 +59,21 @@ void BM_Linear(benchmark::State& state) {
   c.window = static_cast<int>(state.range(0));
   c.order = static_cast<int>(state.range(1));
   c.continuity = static_cast<double>(state.range(2));
-  c.smoothing_r = smoothing_for_cutoff(4.0, 1000.0, c.order);
+  c.smoothing_r = c.smoothing_t = smoothing_for_cutoff(4.0, 1000.0, c.order);
   run_window(state, c, state.range(3) != 0);
 }
+
+// The defaults (adapted smoothing, W = 0.5 s at 1 kHz capped at 128), optionally with
+// positions (two channels adapted) or a prediction horizon of 20 ms.
+void BM_Defaults(benchmark::State& state) {
+  WindowConfig c;
+  if (state.range(1) != 0) c.horizon_s = 0.02;
+  run_window(state, c, state.range(0) != 0);
+}
+BENCHMARK(BM_Defaults)->ArgNames({"pos", "horizon"})->Args({0, 0})->Args({1, 0})->Args({0, 1});
 BENCHMARK(BM_Linear)
     ->ArgNames({"W", "m", "kappa", "pos"})
-    ->Args({32, 2, 0, 0})  // the default
+    ->Args({32, 2, 0, 0})  // the old default
     ->Args({16, 2, 0, 0})
     ->Args({64, 2, 0, 0})
     ->Args({128, 2, 0, 0})

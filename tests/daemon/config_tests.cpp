@@ -837,11 +837,14 @@ TEST(Config, TheDemoConfigReplaysTheBundledExcerpt) {
   EXPECT_TRUE(std::filesystem::equivalent(s.driver.replay.path, kSourceDir / "data/demo/broad-07-excerpt.csv"));
   EXPECT_EQ(s.driver.replay.options.timing, drivers::ReplayTiming::Original);
   EXPECT_EQ(s.driver.replay.options.speed, 1.0);
-  EXPECT_EQ(s.engine.order, 3);
-  EXPECT_EQ(s.engine.window, 32);
+  // The engine's defaults: adapted smoothing, a time-span window, at the recording's rate.
+  const WindowConfig defaults;
+  EXPECT_EQ(s.engine.order, defaults.order);
+  EXPECT_EQ(s.engine.window, 0);
   EXPECT_EQ(s.engine.lag, 0);
-  EXPECT_DOUBLE_EQ(s.engine.smoothing_r.value_or(-1.0), smoothing_for_cutoff(8.0, 285.7, 3));
-  EXPECT_DOUBLE_EQ(s.engine.smoothing_t.value_or(-1.0), smoothing_for_cutoff(8.0, 285.7, 3));
+  EXPECT_FALSE(s.engine.smoothing_r.has_value());
+  EXPECT_FALSE(s.engine.cutoff_hz.has_value());
+  EXPECT_EQ(s.engine.rate_hz, 285.7);
   EXPECT_DOUBLE_EQ(s.engine.epsilon_r, 0.01);
   EXPECT_DOUBLE_EQ(s.engine.epsilon_t, 0.002);
   ASSERT_EQ(c.outputs.size(), 1u);
