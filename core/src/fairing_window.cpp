@@ -478,8 +478,8 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
 }
 
 void FairingWindow::slide(int count) {
-  // Drop the oldest `count` samples (emitted long ago). W moves of a few dozen bytes each.
-  auto drop = [&](auto& v) { std::move(v.begin() + count, v.begin() + n_, v.begin()); };
+  // Drop the oldest `count` samples (emitted long ago): O(1) on average (sliding_array.hpp).
+  auto drop = [&](auto& v) { v.drop_front(static_cast<std::size_t>(count), static_cast<std::size_t>(n_)); };
   drop(samples_);
   drop(z_);
   if (config_.solver == WindowSolver::Linear) {

@@ -33,6 +33,7 @@
 #include "posefair/core/fairing_operators.hpp"
 #include "posefair/core/sample.hpp"
 #include "posefair/core/sample_gate.hpp"
+#include "posefair/core/sliding_array.hpp"
 #include "posefair/core/smoother_rows.hpp"
 #include "posefair/core/smoothing_adaptation.hpp"
 
@@ -189,17 +190,17 @@ class FairingWindow {
   Channel rot_, pos_;
 
   // Per sample, index 0 = oldest.
-  std::vector<Sample> samples_;   // as accepted (time, ids, measured values with their own sign)
-  std::vector<Quat> z_;           // measurement, hemisphere-continuous
-  std::vector<Quat> x_;           // current estimate (iterative solvers)
-  std::vector<Vec3> zeta_;        // ζ_j = log(z_j⁻¹ z_{j+1}) (Linear)
-  std::vector<Vec3> est_;         // e_i: estimate x_i = z_i exp(e_i) (Linear)
-  std::vector<Vec3> c_;           // log(z_i⁻¹ y_i) of emitted samples (Linear)
-  std::vector<Vec3> dzp_;         // p_{j+1} − p_j (Linear)
-  std::vector<Vec3> cp_;          // y_p,i − z_p,i of emitted samples (Linear)
-  std::vector<char> window_clamped_;  // the window bound moved this sample during a solve
-  std::vector<Quat> y_;           // what was emitted (valid for emitted indices)
-  std::vector<Vec3> zp_, xp_, yp_;
+  SlidingArray<Sample> samples_;   // as accepted (time, ids, measured values with their own sign)
+  SlidingArray<Quat> z_;           // measurement, hemisphere-continuous
+  SlidingArray<Quat> x_;           // current estimate (iterative solvers)
+  SlidingArray<Vec3> zeta_;        // ζ_j = log(z_j⁻¹ z_{j+1}) (Linear)
+  SlidingArray<Vec3> est_;         // e_i: estimate x_i = z_i exp(e_i) (Linear)
+  SlidingArray<Vec3> c_;           // log(z_i⁻¹ y_i) of emitted samples (Linear)
+  SlidingArray<Vec3> dzp_;         // p_{j+1} − p_j (Linear)
+  SlidingArray<Vec3> cp_;          // y_p,i − z_p,i of emitted samples (Linear)
+  SlidingArray<char> window_clamped_;  // the window bound moved this sample during a solve
+  SlidingArray<Quat> y_;           // what was emitted (valid for emitted indices)
+  SlidingArray<Vec3> zp_, xp_, yp_;
   // Scratch.
   std::vector<Vec3> e_, u_, w_scratch_, rhs_;
   std::vector<Quat> target_;
