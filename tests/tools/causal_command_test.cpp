@@ -6,6 +6,7 @@
 #include "cli_runner.hpp"
 #include "posefair/core/causal_fairing.hpp"
 #include "posefair/core/fairing_window.hpp"
+#include "posefair/core/quality_metrics.hpp"
 #include "posefair/core/synthetic_motion.hpp"
 #include "posefair/formats/pose_file.hpp"
 
@@ -45,6 +46,8 @@ TEST(CausalCommand, EqualsTheEngineCalledDirectly) {
   gn.iterations = 2;
   gn.order = 3;
   gn.bound = BoundPolicy::Window;
+  WindowConfig predicted;
+  predicted.horizon_s = 0.02;
   WindowConfig sweeps;
   sweeps.order = 3;
   sweeps.window = 16;
@@ -58,6 +61,8 @@ TEST(CausalCommand, EqualsTheEngineCalledDirectly) {
        "--window-iterations 2 --bound window",
        gn},
       {"-m 3 --window 16 --solver sweeps --window-iterations 4 --lambda-r 0.2 --lambda-t 0.3", sweeps},
+      {"", WindowConfig{}},  // the defaults: adapted smoothing, a 0.5 s window
+      {"--horizon 0.02", predicted},
   };
   for (bool with_position : {false, true}) {
     for (const Case& c : cases) {
@@ -71,11 +76,16 @@ TEST(CausalCommand, EqualsTheEngineCalledDirectly) {
       EXPECT_THAT(r.out, HasSubstr("400 emitted"));
       // The file as the CLI read it (values round-trip exactly), through the engine directly.
       const PoseSequence read_back = formats::read_pose_file(in_path, {}).poses();
-      const CausalResult direct = fair_causal(read_back, c.config);
+      // The CLI gives the engine the file's median rate, which a live stream would measure.
+      WindowConfig config = c.config;
+      config.rate_hz = median_sample_rate(read_back.time);
+      const CausalResult direct = fair_causal(read_back, config);
       const PoseSequence cli = formats::read_pose_file(out_path, {}).poses();
       ASSERT_EQ(cli.size(), direct.poses.size());
       for (std::size_t i = 0; i < cli.size(); ++i) {
         ASSERT_EQ(cli.orientation[i].coeffs(), direct.poses.orientation[i].coeffs()) << c.options << " sample " << i;
+        // A prediction is stamped with the time it is for.
+        ASSERT_NEAR(cli.time[i], read_back.time[i] + config.horizon_s, 1e-9) << c.options << " sample " << i;
         if (with_position) {
           ASSERT_EQ(cli.position[i], direct.poses.position[i]) << c.options << " sample " << i;
         }
