@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "posefair/core/difference_operators.hpp"
 #include "posefair/core/engine_setting.hpp"
 
 namespace posefair {
@@ -46,20 +47,6 @@ bool project_position(const Vec3& z, Vec3& p, double eps) {
   }
   p = z;
   return true;
-}
-
-// In place: v (length len) -> D v (length len-1), the forward difference.
-void difference(std::span<Vec3> v, int len) {
-  for (int i = 0; i + 1 < len; ++i) v[static_cast<std::size_t>(i)] = v[static_cast<std::size_t>(i + 1)] - v[static_cast<std::size_t>(i)];
-}
-
-// In place: v (length len) -> Dᵀ v (length len+1), the adjoint of the forward difference.
-void difference_adjoint(std::span<Vec3> v, int len) {
-  for (int i = len; i >= 0; --i) {
-    const Vec3 prev = i > 0 ? v[static_cast<std::size_t>(i - 1)] : Vec3::Zero();
-    const Vec3 here = i < len ? v[static_cast<std::size_t>(i)] : Vec3::Zero();
-    v[static_cast<std::size_t>(i)] = prev - here;
-  }
 }
 
 enum class SmoothingSource { Given, Cutoff, Adaptive };
@@ -585,8 +572,8 @@ void FairingWindow::smoothness_gradient(std::span<const Vec3> w1) {
   const int n = n_, m = config_.order;
   if (w1.data() != w_scratch_.data()) std::copy(w1.begin(), w1.begin() + (n - 1), w_scratch_.begin());
   int len = n - 1;
-  for (int p = 1; p < m; ++p) difference(w_scratch_, len--);
-  for (int p = 0; p < m; ++p) difference_adjoint(w_scratch_, len++);
+  for (int p = 1; p < m; ++p) forward_difference_in_place(w_scratch_, len--);
+  for (int p = 0; p < m; ++p) difference_adjoint_in_place(w_scratch_, len++);
   for (int i = 0; i < n; ++i) rhs_[static_cast<std::size_t>(i)] -= rot_.mu * w_scratch_[static_cast<std::size_t>(i)];
 }
 

@@ -1,26 +1,12 @@
 #include "posefair/core/smoother_rows.hpp"
 
+#include "posefair/core/difference_operators.hpp"
+
 #include <algorithm>
 #include <cmath>
 
 namespace posefair {
 namespace {
-
-// In place: v (length len) -> D v (length len-1), the forward difference.
-template <class T>
-void difference(std::span<T> v, int len) {
-  for (int i = 0; i + 1 < len; ++i) v[static_cast<std::size_t>(i)] = v[static_cast<std::size_t>(i + 1)] - v[static_cast<std::size_t>(i)];
-}
-
-// In place: v (length len) -> Dᵀ v (length len+1), the adjoint of the forward difference.
-template <class T>
-void difference_adjoint(std::span<T> v, int len, T zero) {
-  for (int i = len; i >= 0; --i) {
-    const T prev = i > 0 ? v[static_cast<std::size_t>(i - 1)] : zero;
-    const T here = i < len ? v[static_cast<std::size_t>(i)] : zero;
-    v[static_cast<std::size_t>(i)] = prev - here;
-  }
-}
 
 double factorial(int m) {
   double f = 1.0;
@@ -61,8 +47,8 @@ void EmissionRowBuilder::correction_weights(int n, double mu, int k, std::span<d
   if (n <= m || mu == 0.0) return;
   int len = n;
   const std::span<Vec3> v(scratch_);
-  for (int p = 0; p < m; ++p) difference(v, len--);
-  for (int p = 1; p < m; ++p) difference_adjoint(v, len++, Vec3(Vec3::Zero()));
+  for (int p = 0; p < m; ++p) forward_difference_in_place(v, len--);
+  for (int p = 1; p < m; ++p) difference_adjoint_in_place(v, len++);
   for (int j = 0; j < n - 1; ++j) hk[static_cast<std::size_t>(j)] = -mu * scratch_[static_cast<std::size_t>(j)].x();
 }
 
@@ -130,8 +116,8 @@ bool EmissionRowBuilder::solve_window(int n, double mu, const EmissionTarget& t,
     std::copy(zeta.begin(), zeta.begin() + (n - 1), scratch_.begin());
     int len = n - 1;
     const std::span<Vec3> v(scratch_);
-    for (int p = 1; p < m; ++p) difference(v, len--);
-    for (int p = 0; p < m; ++p) difference_adjoint(v, len++, Vec3(Vec3::Zero()));
+    for (int p = 1; p < m; ++p) forward_difference_in_place(v, len--);
+    for (int p = 0; p < m; ++p) difference_adjoint_in_place(v, len++);
     for (int i = 0; i < n; ++i) est[static_cast<std::size_t>(i)] -= mu * scratch_[static_cast<std::size_t>(i)];
   }
   system_.solve(est.first(static_cast<std::size_t>(n)));

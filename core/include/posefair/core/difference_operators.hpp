@@ -19,4 +19,17 @@ std::vector<Vec3> orientation_differences(std::span<const Quat> q, int m);
 double translational_energy(std::span<const Vec3> p, int m);
 double rotational_energy(std::span<const Quat> q, int m);
 
+// In place, on the first len entries of v (no allocation, for the real-time window):
+// v -> D v (len-1 entries, the forward difference), and v -> Dᵀ v (len+1 entries, its adjoint).
+inline void forward_difference_in_place(std::span<Vec3> v, int len) {
+  for (int i = 0; i + 1 < len; ++i) v[static_cast<std::size_t>(i)] = v[static_cast<std::size_t>(i + 1)] - v[static_cast<std::size_t>(i)];
+}
+inline void difference_adjoint_in_place(std::span<Vec3> v, int len) {
+  for (int i = len; i >= 0; --i) {
+    const Vec3 prev = i > 0 ? v[static_cast<std::size_t>(i - 1)] : Vec3::Zero();
+    const Vec3 here = i < len ? v[static_cast<std::size_t>(i)] : Vec3::Zero();
+    v[static_cast<std::size_t>(i)] = prev - here;
+  }
+}
+
 }  // namespace posefair
