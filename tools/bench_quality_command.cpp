@@ -404,7 +404,7 @@ void print_prediction(const std::vector<PredictionRuns>& all, std::ofstream& sum
     if (!r.engine_stamped_ahead)
       std::printf(" **This engine ignores horizon_s** (its poses are stamped with the sample time): its row is the unpredicted smoothed pose.");
     if (r.engine_delivery_ms > 0.01) std::printf(" posefair delivers its predictions %.2f ms after their sample (mean, worst sequence).", r.engine_delivery_ms);
-    std::printf("\n\n| predictor | 10 ms | 20 ms | 30 ms | jitter at 20 ms | configuration |\n|---|---|---|---|---|---|\n");
+    std::printf("\n\n| predictor | 10 ms | 20 ms | 30 ms | jitter at 20 ms | configuration at 20 ms |\n|---|---|---|---|---|---|\n");
     const std::size_t hold = 0;
     std::vector<double> best_baseline_20(1, std::numeric_limits<double>::infinity());
     std::string best_name;
