@@ -14,6 +14,7 @@ namespace posefair {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 using testing::run_posefair;
 using testing::ScratchDir;
 
@@ -112,16 +113,26 @@ TEST(CausalCommand, CutoffNeedsTheFileRateAndWindowOptionsNeedCausal) {
   EXPECT_THAT(r.out, HasSubstr("lag 2 (20 ms)"));
 }
 
-TEST(BenchQuality, QuickRunWritesBothFamiliesAndASummary) {
+TEST(BenchQuality, QuickRunTunesOnTrainingSeedsAndReportsEveryRow) {
   ScratchDir dir;
   const auto r = run_posefair("bench quality --quick -o '" + dir.path().string() + "'", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string runs = testing::slurp(dir / "quality-runs.csv");
-  EXPECT_THAT(runs, HasSubstr("dataset,family,config,error"));
-  EXPECT_THAT(runs, HasSubstr(",one-euro,"));
-  EXPECT_THAT(runs, HasSubstr(",posefair,"));
-  EXPECT_THAT(runs, HasSubstr(",posefair-sweeps,"));
-  EXPECT_THAT(r.out, HasSubstr("comparisons"));
+  EXPECT_THAT(runs, HasSubstr("dataset,sequence,role,family,config,error_delivered,error_aligned,lag_ms"));
+  for (const char* family : {",raw,", ",posefair-default,", ",one-euro-default,", ",posefair,", ",one-euro,", ",slerp,",
+                             ",posefair-sweeps,"})
+    EXPECT_THAT(runs, HasSubstr(family)) << family;
+  // Tuned on seed 1, reported on seeds 2 and 3: the split is in the file, row by row.
+  EXPECT_THAT(runs, HasSubstr("synthetic-100Hz-noise0.01,seed1,train,"));
+  EXPECT_THAT(runs, HasSubstr("synthetic-100Hz-noise0.01,seed2,report,"));
+  EXPECT_THAT(runs, Not(HasSubstr(",seed1,report,")));
+  const std::string prediction = testing::slurp(dir / "quality-prediction-summary.csv");
+  for (const char* row : {",10,dead-reckoning,", ",20,slerp-extrapolation,", ",30,one-euro-dr,", ",20,posefair-default,"})
+    EXPECT_THAT(prediction, HasSubstr(row)) << row;
+  EXPECT_THAT(r.out, HasSubstr("| posefair default | fixed |"));
+  EXPECT_THAT(r.out, HasSubstr("| One Euro tuned | 10 ms |"));
+  EXPECT_THAT(r.out, HasSubstr("Where posefair's defaults lose"));
+  EXPECT_THAT(r.out, Not(HasSubstr("none fits")));  // every budget has a row of every tuned family
 }
 
 }  // namespace
