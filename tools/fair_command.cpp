@@ -261,6 +261,11 @@ void add_fair_command(CLI::App& app, int& exit_code) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str()
       ->needs(causal);
+  cmd->add_option("--gap-intervals", o->window.gate.gap_intervals,
+                  "causal: a time step longer than this many of the stream's intervals also restarts the window (0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str()
+      ->needs(causal);
   cmd->callback([o, &exit_code] { exit_code = run_fair(*o); });
 }
 

@@ -59,30 +59,40 @@ std::vector<SmoothingCandidate> smoothing_candidates(const QualityDataset& d, bo
   out.push_back({"one-euro-default", "mincutoff=1Hz beta=0 dcutoff=1Hz",
                  [](const QualitySequence& q) { return run_filter(q.input, QuatOneEuroFilter(1.0, 0.0, 1.0)); }});
 
-  // posefair tuned: 80 configurations. m × 10 cutoffs (0.25 Hz to 0.4 of the slowest rate) ×
-  // {W 32 lag 0, W 16 lag 0, lag ≤ 10 ms, lag ≤ 30 ms}. Lags are whole samples (the most that
-  // fit the time, at least 1); the window is 32 samples, or 16 more than the lag. μ is capped at
-  // the engine's largest (kMaxSmoothing), which low cutoffs at 1 kHz reach. Gaps longer than
+  // posefair tuned: 80 configurations. m × (the adapted smoothing and 9 cutoffs, 0.25 Hz to 0.4
+  // of the slowest rate) × {lag 0 with the default 0.5 s window, lag 0 with W = 32, lag ≤ 10 ms,
+  // lag ≤ 30 ms}. Lags are whole samples (the most that fit the time, at least 1). μ is capped
+  // at the engine's largest (kMaxSmoothing), which low cutoffs at 1 kHz reach. Gaps longer than
   // 2.5 periods restart the window (a fixed choice, not a tuned axis).
-  const std::vector<double> cutoffs = log_spaced(0.25, 0.4 * rate, 10);
+  const std::vector<double> cutoffs = log_spaced(0.25, 0.4 * rate, 9);
   struct Variant {
-    int window;
+    int window;  // 0: the default time span
     double lag_s;
   };
-  const Variant variants[] = {{32, 0.0}, {16, 0.0}, {32, 0.010}, {32, 0.030}};
+  const Variant variants[] = {{0, 0.0}, {32, 0.0}, {0, 0.010}, {0, 0.030}};
+  std::vector<double> smoothings = cutoffs;
+  smoothings.insert(smoothings.begin(), 0.0);  // 0: adapted
   for (int m : {2, 3})
-    for (double fc : cutoffs)
+    for (double fc : smoothings)
       for (const Variant& v : variants) {
-        if (v.lag_s > 0.0)
-          std::snprintf(buf, sizeof buf, "m=%d cutoff=%gHz W=max(32,L+16) lag<=%gms", m, fc, 1e3 * v.lag_s);
+        char smoothing[40];
+        if (fc > 0.0)
+          std::snprintf(smoothing, sizeof smoothing, "cutoff=%gHz", fc);
         else
-          std::snprintf(buf, sizeof buf, "m=%d cutoff=%gHz W=%d lag=0", m, fc, v.window);
+          std::snprintf(smoothing, sizeof smoothing, "adapted");
+        if (v.lag_s > 0.0)
+          std::snprintf(buf, sizeof buf, "m=%d %s lag<=%gms", m, smoothing, 1e3 * v.lag_s);
+        else if (v.window > 0)
+          std::snprintf(buf, sizeof buf, "m=%d %s W=%d lag=0", m, smoothing, v.window);
+        else
+          std::snprintf(buf, sizeof buf, "m=%d %s lag=0", m, smoothing);
         out.push_back({"posefair", buf, [m, fc, v](const QualitySequence& q) {
                          WindowConfig c;
                          c.order = m;
                          c.lag = lag_samples(v.lag_s, q.rate_hz);
-                         c.window = std::max(v.window, c.lag + 16);
-                         c.smoothing_r = std::min(kMaxSmoothing, smoothing_for_cutoff(fc, q.rate_hz, m));
+                         c.window = v.window;
+                         if (fc > 0.0) c.smoothing_r = std::min(kMaxSmoothing, smoothing_for_cutoff(fc, q.rate_hz, m));
+                         c.rate_hz = q.rate_hz;
                          c.gate.gap_threshold = 2.5 / q.rate_hz;
                          return run_engine(q.input, c);
                        }});
@@ -109,7 +119,7 @@ std::vector<SmoothingCandidate> smoothing_candidates(const QualityDataset& d, bo
   if (d.kind != "synthetic") return out;
   // Solver tables (synthetic only), lag 0, W = 32: Gauss–Newton (2 iterations) at 5 cutoffs …
   const std::vector<double> gn_cutoffs = quick ? std::vector<double>{cutoffs[2], cutoffs[5]}
-                                               : std::vector<double>{cutoffs[1], cutoffs[3], cutoffs[5], cutoffs[7], cutoffs[9]};
+                                               : std::vector<double>{cutoffs[1], cutoffs[3], cutoffs[5], cutoffs[7], cutoffs[8]};
   for (int m : {2, 3})
     for (double fc : gn_cutoffs) {
       std::snprintf(buf, sizeof buf, "m=%d cutoff=%gHz W=32 lag=0ms iterations=2", m, fc);
@@ -117,6 +127,7 @@ std::vector<SmoothingCandidate> smoothing_candidates(const QualityDataset& d, bo
                        WindowConfig c;
                        c.order = m;
                        c.solver = WindowSolver::GaussNewton;
+                       c.window = 32;
                        c.iterations = 2;
                        c.smoothing_r = std::min(kMaxSmoothing, smoothing_for_cutoff(fc, q.rate_hz, m));
                        c.gate.gap_threshold = 2.5 / q.rate_hz;
@@ -156,6 +167,7 @@ std::vector<SmoothingCandidate> smoothing_candidates(const QualityDataset& d, bo
       out.push_back({"posefair-bound", buf, [solver, bound, noise](const QualitySequence& q) {
                        WindowConfig c;
                        c.order = 2;
+                       c.window = 32;
                        c.solver = solver;
                        c.iterations = 2;
                        c.smoothing_r = smoothing_for_cutoff(4.0, q.rate_hz, 2);

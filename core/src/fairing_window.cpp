@@ -224,6 +224,7 @@ void FairingWindow::note_interval(double dt) {
 // at construction or after the first intervals; the storage exists already, so it allocates nothing.
 void FairingWindow::prepare(double rate_hz) {
   rate_ = rate_hz;
+  if (rate_hz > 0.0) gate_.set_interval(1.0 / rate_hz);
   const int m = config_.order;
   if (config_.window > 0) {
     w_ = config_.window;

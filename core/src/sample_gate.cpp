@@ -1,5 +1,6 @@
 #include "posefair/core/sample_gate.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -7,11 +8,18 @@
 
 namespace posefair {
 
-SampleGate::SampleGate(const GateConfig& config) : config_(config) {
+SampleGate::SampleGate(const GateConfig& config) : config_(config), gap_(config.gap_threshold) {
   if (!(config.unit_tolerance >= 0.0 && config.unit_tolerance < 1.0))
     throw InvalidEngineSetting(EngineSetting::UnitTolerance, "unit_tolerance must be in [0, 1)");
   if (!(config.gap_threshold > 0.0))
     throw InvalidEngineSetting(EngineSetting::GapThreshold, "gap_threshold must be positive");
+  if (!(config.gap_intervals == 0.0 || (config.gap_intervals >= 1.5 && config.gap_intervals <= 1e6)))
+    throw InvalidEngineSetting(EngineSetting::GapThreshold, "gap_intervals must be 0 (off) or in [1.5, 1e6]");
+}
+
+void SampleGate::set_interval(double interval) {
+  gap_ = config_.gap_threshold;
+  if (config_.gap_intervals > 0.0 && interval > 0.0) gap_ = std::min(gap_, config_.gap_intervals * interval);
 }
 
 GateVerdict SampleGate::check(Sample& s) {
@@ -42,7 +50,7 @@ GateVerdict SampleGate::check(Sample& s) {
     s.orientation.coeffs() /= norm;
     ++counters_.renormalised;
   }
-  const bool gap = s.time - last_time_ > config_.gap_threshold && std::isfinite(last_time_);
+  const bool gap = s.time - last_time_ > gap_ && std::isfinite(last_time_);
   last_time_ = s.time;
   ++counters_.accepted;
   if (gap) {

@@ -132,7 +132,7 @@ constexpr std::string_view kLoggingKeys[] = {"level", "target", "status_interval
 constexpr std::string_view kEngineKeys[] = {
     "window",   "window_time", "max_window", "lag", "horizon", "order", "solver", "iterations", "smoothing", "smoothing_r",
     "smoothing_t", "cutoff_hz", "rate_hz", "continuity", "lambda_r", "lambda_t", "variant",
-    "epsilon_r", "epsilon_t", "bound",  "gap",       "unit_tolerance"};
+    "epsilon_r", "epsilon_t", "bound",  "gap",       "gap_intervals", "unit_tolerance"};
 constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "overflow", "driver", "engine", "spline", "gpio"};
 constexpr std::string_view kGpioKeys[] = {"chip",          "data_ready_line", "edge",        "bias",         "tolerance_min",
                                           "tolerance_max", "output_line",     "output_mode", "heartbeat_hz", "reconnect_min",
@@ -310,7 +310,7 @@ struct EngineLayer {
   std::optional<Given<int>> window, max_window, lag, order, iterations;
   std::optional<Given<WindowSolver>> solver;
   std::optional<Given<double>> window_time, horizon, smoothing, smoothing_r, smoothing_t, cutoff_hz, rate_hz, continuity, lambda_r,
-      lambda_t, epsilon_r, epsilon_t, gap, unit_tolerance;
+      lambda_t, epsilon_r, epsilon_t, gap, gap_intervals, unit_tolerance;
   std::optional<Given<OperatorVariant>> variant;
   std::optional<Given<BoundPolicy>> bound;
 };
@@ -553,6 +553,7 @@ class Parser {
     choice("bound", e.bound,
            std::initializer_list<Choice<BoundPolicy>>{{"sample", BoundPolicy::Sample}, {"window", BoundPolicy::Window}});
     real("gap", e.gap, kPositive);
+    real("gap_intervals", e.gap_intervals, kNonNegative);
     real("unit_tolerance", e.unit_tolerance, FloatRange{0.0, true, 1.0, true});
 
     if (e.cutoff_hz) {
@@ -604,6 +605,7 @@ class Parser {
       take(layer->epsilon_t, c.epsilon_t, EngineSetting::EpsilonT);
       take(layer->bound, c.bound, EngineSetting::Bound);
       take(layer->gap, c.gate.gap_threshold, EngineSetting::GapThreshold);
+      take(layer->gap_intervals, c.gate.gap_intervals, EngineSetting::GapThreshold);
       take(layer->unit_tolerance, c.gate.unit_tolerance, EngineSetting::UnitTolerance);
       if (layer->epsilon_r) {
         // Given as a rotation angle; the engine's bound is the distance on S³, half of it.

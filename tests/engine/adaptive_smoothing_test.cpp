@@ -220,8 +220,9 @@ TEST(EmissionRows, TheirBiasAndNoiseGainPredictTheEngine) {
       for (int j = 0; j < k; ++j) {
         const FairedPose& f = out[static_cast<std::size_t>(j)];
         const auto at = static_cast<int>(f.sequence);
-        if (!noisy && at >= 60 && at < 200 - lag - 1)
+        if (!noisy && at >= 60 && at < 200 - lag - 1) {
           EXPECT_NEAR(f.position.x() - 0.5 * a * at * at, a * row.bias, 1e-7) << "lag " << lag << " sample " << at;
+        }
         if (at >= 300) {
           sum_sq += f.position.squaredNorm() / 3.0;
           ++count;

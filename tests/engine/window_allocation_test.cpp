@@ -127,7 +127,9 @@ TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
     // The run did what it was meant to: everything emitted once, one gap restart, a rejection,
     // and the bound was exercised.
     EXPECT_EQ(emitted, warm.size() + kMeasured);
-    if (c.defaults) EXPECT_GT(w.state().rate_hz, 0.0) << "the rate was never measured";
+    if (c.defaults) {
+      EXPECT_GT(w.state().rate_hz, 0.0) << "the rate was never measured";
+    }
     EXPECT_EQ(w.counters().restarts, 1u);
     EXPECT_EQ(w.gate_counters().rejected_non_unit, 1u);
     EXPECT_GT(w.counters().clamped, 0u);

@@ -67,7 +67,6 @@ struct WindowConfig {
   double epsilon_t = std::numeric_limits<double>::infinity();  // position units
   BoundPolicy bound = BoundPolicy::Sample;  // Window needs an iterative solver
   GateConfig gate;
-  double horizon_s = 0.0;          // seconds ahead: emit each pose predicted for sample time + horizon_s (placeholder: the engine does not read it yet)
 };
 
 // Largest accepted smoothing weight μ (see validate()).

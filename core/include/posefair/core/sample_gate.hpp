@@ -4,8 +4,10 @@
 //   - |‖q‖ − 1| ≤ unit_tolerance: renormalised (counted); beyond it: rejected;
 //   - time not after the last accepted sample's: dropped (repeated or out of order; an
 //     older sample cannot be placed in a window that has moved on);
-//   - time more than gap_threshold after the last accepted sample: accepted, and the window
-//     must restart (the operators assume evenly spaced samples).
+//   - time more than gap_threshold after the last accepted sample, or more than
+//     gap_intervals of the stream's sample interval once that is known: accepted, and the
+//     window must restart (the operators assume evenly spaced samples; a 100 ms dropout in a
+//     285 Hz stream is 28 missing samples, not one long step).
 // Sample times may jitter: the fairing operators treat consecutive samples as evenly spaced.
 #include <cstdint>
 #include <limits>
@@ -17,6 +19,7 @@ namespace posefair {
 struct GateConfig {
   double unit_tolerance = 0.01;
   double gap_threshold = 0.25;  // seconds
+  double gap_intervals = 4.0;   // a step this many sample intervals long is a gap too (0: off)
 };
 
 enum class GateVerdict {
@@ -52,9 +55,14 @@ class SampleGate {
   void restart() { last_time_ = -std::numeric_limits<double>::infinity(); }
   const GateCounters& counters() const { return counters_; }
   const GateConfig& config() const { return config_; }
+  // The stream's sample interval (seconds), once known: a step longer than gap_intervals of
+  // it is a gap as well. The longest step accepted without a restart is gap().
+  void set_interval(double interval);
+  double gap() const { return gap_; }
 
  private:
   GateConfig config_;
+  double gap_ = 0.0;
   GateCounters counters_;
   double last_time_ = -std::numeric_limits<double>::infinity();
 };

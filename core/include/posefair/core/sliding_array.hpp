@@ -13,7 +13,11 @@ namespace posefair {
 template <class T>
 class SlidingArray {
  public:
-  void resize(std::size_t capacity) { assign(capacity, T{}); }
+  void resize(std::size_t capacity) {
+    capacity_ = capacity;
+    base_ = 0;
+    storage_.resize(2 * capacity);  // every element is written before it is read
+  }
   void assign(std::size_t capacity, const T& value) {
     capacity_ = capacity;
     base_ = 0;
