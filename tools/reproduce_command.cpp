@@ -6,6 +6,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
+#include <string>
+#include <utility>
 
 #include "posefair/core/error.hpp"
 #include "posefair/core/fairing_study.hpp"
@@ -18,16 +21,127 @@ struct Run {
   int order;
   double lambda_r;
   OperatorVariant variant;
+  bool figures_4_to_8 = false;  // the perturbation of Figs. 4–8 (0.2 rad, 20 mm), not Section 6's
 };
 
 // Figures 2–5 of the paper: m = 2 vs 3 at λ_r = 0.1; λ_r = 0.1/0.2/0.3 for m = 3 (and m = 2);
-// the printed operators beside the corrected ones.
+// the printed operators beside the corrected ones; and Figs. 4–5 on their own setup.
 constexpr Run kRuns[] = {
     {"m2-l0.1", 2, 0.1, OperatorVariant::Corrected}, {"m2-l0.2", 2, 0.2, OperatorVariant::Corrected},
     {"m2-l0.3", 2, 0.3, OperatorVariant::Corrected}, {"m3-l0.1", 3, 0.1, OperatorVariant::Corrected},
     {"m3-l0.2", 3, 0.2, OperatorVariant::Corrected}, {"m3-l0.3", 3, 0.3, OperatorVariant::Corrected},
     {"m2-l0.1-printed", 2, 0.1, OperatorVariant::Printed}, {"m3-l0.1-printed", 3, 0.1, OperatorVariant::Printed},
+    {"m3-l0.1-fig4-8", 3, 0.1, OperatorVariant::Corrected, true},
 };
+
+// Section 6: ‖δ_r‖ < 0.1, ‖δ_t‖ < 10 mm. Figures 4–8: "within 0.2 (radians) … and 20 (mm)".
+SyntheticMotionSpec section6_spec() { return {}; }
+SyntheticMotionSpec figures_4_to_8_spec() {
+  SyntheticMotionSpec s;
+  s.rotation_noise = 0.2;
+  s.position_noise = 20.0;
+  return s;
+}
+
+std::filesystem::path beside(const std::filesystem::path& out, const std::string& suffix) {
+  return out.parent_path() / (out.stem().string() + "-" + suffix + ".csv");
+}
+
+std::ofstream open_csv(const std::filesystem::path& path, const char* header) {
+  std::ofstream f(path);
+  if (f) f << header << "\n";
+  return f;
+}
+
+// Fig. 1's loop with ε at the perturbation bound, positions and orientations together, and
+// each bound alone (to see which one stops it).
+bool bound_table(const std::filesystem::path& path, int seeds) {
+  std::ofstream f = open_csv(path, "setup,order,bounds,seed,iterations,stop,breaking_rotation,breaking_position,first_breaking");
+  if (!f) return false;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::printf("\nFig. 1 loop at the perturbation bound (lambda_t 0.5, lambda_r 0.1; sweeps kept per seed):\n");
+  for (const bool fig : {false, true}) {
+    const SyntheticMotionSpec spec = fig ? figures_4_to_8_spec() : section6_spec();
+    const char* setup = fig ? "figs4-8" : "section6";
+    for (int order : {2, 3}) {
+      for (const char* bounds : {"both", "rotation", "position"}) {
+        FairingParams p;
+        p.order = order;
+        p.max_iterations = 100000;
+        const bool rot = bounds[0] != 'p', pos = bounds[0] != 'r';
+        p.epsilon_r = rot ? spec.rotation_noise : kInf;
+        p.epsilon_t = pos ? spec.position_noise : kInf;
+        const auto runs = bounded_runs(spec, seeds, p);
+        std::printf("  %-8s m=%d eps %-8s:", setup, order, bounds);
+        for (const auto& r : runs) {
+          std::printf(" %4d", r.iterations);
+          f << setup << ',' << order << ',' << bounds << ',' << r.seed << ',' << r.iterations << ','
+            << to_string(r.stop) << ',' << r.breaking_rotation << ',' << r.breaking_position << ','
+            << r.first_breaking << '\n';
+        }
+        std::printf("   (next sweep breaks it at sample");
+        for (const auto& r : runs) std::printf(" %td", r.first_breaking);
+        std::printf(")\n");
+      }
+    }
+  }
+  return static_cast<bool>(f);
+}
+
+// Claim (a) on motions of different curvature: the number of slow oscillations over the
+// 100 samples, 0.25 to 4 (Section 6's data: 1).
+bool curvature_table(const std::filesystem::path& path, int seeds) {
+  std::ofstream f = open_csv(path, "cycles,truth_angular_acceleration,order,iteration,mean_error_to_input,mean_error_to_truth");
+  if (!f) return false;
+  std::printf("\nClaim (a) by curvature (Section 6 noise, lambda_r 0.1, mean of %d seeds; error to input / to truth):\n", seeds);
+  for (double cycles : {0.25, 0.5, 1.0, 2.0, 4.0}) {
+    SyntheticMotionSpec spec = section6_spec();
+    spec.cycles = cycles;
+    double curvature = 0.0;
+    for (int s = 1; s <= seeds; ++s) {
+      spec.seed = static_cast<std::uint64_t>(s);
+      curvature += mean_angular_acceleration(make_synthetic_motion(spec).truth) / seeds;
+    }
+    std::printf("  cycles %4.2f (truth %6.1f rad/s2):", cycles, curvature);
+    for (int order : {2, 3}) {
+      FairingParams p;
+      p.order = order;
+      p.max_iterations = 1000;
+      const auto t = mean_trace(spec, seeds, p);
+      for (int k : {100, 1000}) {
+        f << cycles << ',' << curvature << ',' << order << ',' << k << ',' << t[k].mean_error_to_input << ','
+          << t[k].mean_error_to_truth << '\n';
+      }
+      std::printf("  m=%d @100 %.4f/%.4f @1000 %.4f/%.4f", order, t[100].mean_error_to_input, t[100].mean_error_to_truth,
+                  t[1000].mean_error_to_input, t[1000].mean_error_to_truth);
+    }
+    std::printf("\n");
+  }
+  return static_cast<bool>(f);
+}
+
+// Figures 6–8: one motion of the Figs. 4–8 setup, m = 3, 100 sweeps, without a bound.
+bool motion_table(const std::filesystem::path& path) {
+  std::ofstream f = open_csv(path, "stage,i,t,px,py,pz,qw,qx,qy,qz");
+  if (!f) return false;
+  FairingParams p;
+  p.order = 3;
+  p.max_iterations = 100;
+  const auto st = faired_motion_stages(figures_4_to_8_spec(), p);
+  const std::pair<const char*, const PoseSequence*> stages[] = {
+      {"truth", &st.truth}, {"noisy", &st.noisy}, {"translation", &st.translation_faired}, {"faired", &st.faired}};
+  for (const auto& [name, s] : stages) {
+    for (std::size_t i = 0; i < s->size(); ++i) {
+      const Quat& q = s->orientation[i];
+      const Vec3& x = s->position[i];
+      char line[256];
+      std::snprintf(line, sizeof line, "%s,%zu,%.4f,%.9g,%.9g,%.9g,%.12g,%.12g,%.12g,%.12g\n", name, i, s->time[i], x.x(),
+                    x.y(), x.z(), q.w(), q.x(), q.y(), q.z());
+      f << line;
+    }
+  }
+  return static_cast<bool>(f);
+}
 
 int reproduce_lee_shin(const std::filesystem::path& out, int iterations, int seeds) {
   std::ofstream f(out);
@@ -43,7 +157,7 @@ int reproduce_lee_shin(const std::filesystem::path& out, int iterations, int see
     p.lambda_r = run.lambda_r;
     p.variant = run.variant;
     p.max_iterations = iterations;
-    const auto trace = mean_trace(SyntheticMotionSpec{}, seeds, p);
+    const auto trace = mean_trace(run.figures_4_to_8 ? figures_4_to_8_spec() : section6_spec(), seeds, p);
     for (const auto& t : trace) {
       char line[512];
       std::snprintf(line, sizeof line, "%s,%d,%.2f,%s,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", run.name, run.order,
@@ -55,13 +169,20 @@ int reproduce_lee_shin(const std::filesystem::path& out, int iterations, int see
     const auto& last = trace.back();
     std::printf("%-16s after %4d sweeps: mean error to input %.4f, to truth %.4f (input %.4f) rad on S3\n", run.name,
                 last.iteration, last.mean_error_to_input, last.mean_error_to_truth, trace.front().mean_error_to_truth);
+    if (run.figures_4_to_8 && trace.size() > 100) {
+      std::printf("%-16s angular acceleration %.0f -> %.0f (10 sweeps) -> %.0f (100) rad/s2; "
+                  "acceleration %.0f -> %.0f -> %.0f mm/s2\n", "", trace[0].mean_angular_acceleration,
+                  trace[10].mean_angular_acceleration, trace[100].mean_angular_acceleration, trace[0].mean_acceleration,
+                  trace[10].mean_acceleration, trace[100].mean_acceleration);
+    }
   }
   f.close();
-  if (!f) {
-    std::cerr << "posefair reproduce: writing " << out << " failed\n";
+  const auto bound = beside(out, "bound"), curvature = beside(out, "curvature"), motion = beside(out, "motion");
+  if (!f || !bound_table(bound, seeds) || !curvature_table(curvature, seeds) || !motion_table(motion)) {
+    std::cerr << "posefair reproduce: writing " << out << " or the tables beside it failed\n";
     return exit_code(ErrorKind::CantCreate);
   }
-  std::printf("wrote %s\n", out.c_str());
+  std::printf("wrote %s, %s, %s, %s\n", out.c_str(), bound.c_str(), curvature.c_str(), motion.c_str());
   return kExitOk;
 }
 
@@ -70,7 +191,10 @@ int reproduce_lee_shin(const std::filesystem::path& out, int iterations, int see
 void add_reproduce_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("reproduce", "Reproduce a source paper's experiments as CSV (see docs/)");
   cmd->require_subcommand(1);
-  auto* ls = cmd->add_subcommand("lee-shin", "Lee & Shin Section 6: error and acceleration vs iteration");
+  auto* ls = cmd->add_subcommand("lee-shin",
+                                 "Lee & Shin Section 6: error and acceleration vs iteration; beside the CSV, "
+                                 "Fig. 1's loop at the bound (-bound.csv), claim (a) by curvature (-curvature.csv) "
+                                 "and the motions of Figs. 6-8 (-motion.csv)");
   auto out = std::make_shared<std::string>("lee-shin-section6.csv");
   auto iterations = std::make_shared<int>(1000);
   auto seeds = std::make_shared<int>(5);
