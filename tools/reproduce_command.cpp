@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -9,9 +10,12 @@
 #include <limits>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "posefair/core/error.hpp"
 #include "posefair/core/fairing_study.hpp"
+#include "posefair/core/quaternion_spline_example.hpp"
+#include "posefair/core/quaternion_spline_study.hpp"
 
 namespace posefair::tools {
 namespace {
@@ -186,6 +190,67 @@ int reproduce_lee_shin(const std::filesystem::path& out, int iterations, int see
   return kExitOk;
 }
 
+// Ramamoorthi & Barr Section 4 on the documented example and on seeded random key sets of the
+// same kind: the 4-frame gap to the optimum and the norm deviation, each set and their spread.
+int reproduce_ramamoorthi_barr(const std::filesystem::path& out, int seeds) {
+  std::ofstream f = open_csv(out, "family,keys,optimum,gap_4,gap_8,gap_24,max_norm_deviation_4,mean_norm_deviation_4");
+  if (!f) {
+    std::cerr << "posefair reproduce: cannot write " << out << "\n";
+    return exit_code(ErrorKind::CantCreate);
+  }
+  auto spread = [](std::vector<double> v, double scale) {
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    const double median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    char text[96];
+    std::snprintf(text, sizeof text, "%.3g / %.3g / %.3g", scale * v.front(), scale * median, scale * v.back());
+    return std::string(text);
+  };
+  auto row = [&](const char* family, const std::string& name, const KeySetClaims& c) {
+    std::printf("%-10s %9.5f   %8.3f%%   %7.3f%%  %8.4f%%   %9.3f%%   %10.4f%%   %7.3f\n", name.c_str(), c.optimum,
+                100 * c.gap_4, 100 * c.gap_8, 100 * c.gap_24, 100 * c.max_norm_deviation_4, 100 * c.mean_norm_deviation_4,
+                c.mean_norm_deviation_4 / c.max_norm_deviation_4);
+    f << family << ',' << name << ',' << c.optimum << ',' << c.gap_4 << ',' << c.gap_8 << ',' << c.gap_24 << ','
+      << c.max_norm_deviation_4 << ',' << c.mean_norm_deviation_4 << '\n';
+  };
+  const char* header = "keys         optimum   gap 4 frames  8 frames  24 frames   max ||q|-1|  mean ||q|-1|  mean/max\n";
+  std::printf("the example (docs/examples/quaternion-splines-7keys.txt):\n%s", header);
+  row("example", "example", key_set_claims(seven_keyframe_example()));
+  // Steps like the example's, and steps of a third of that.
+  const struct {
+    const char* family;
+    double min_step, max_step;
+  } families[] = {{"steps 30-50", 30.0, 50.0}, {"steps 10-20", 10.0, 20.0}};
+  for (const auto& fam : families) {
+    std::printf("\nrandom key sets, %s degrees on S3 between keys:\n%s", fam.family, header);
+    std::vector<double> gap4, gap8, ratio, max_dev;
+    int within = 0;
+    for (int s = 1; s <= seeds; ++s) {
+      const KeySetClaims c =
+          key_set_claims(random_seven_keyframes(static_cast<std::uint64_t>(s), fam.min_step, fam.max_step));
+      row(fam.family, "seed " + std::to_string(s), c);
+      gap4.push_back(c.gap_4);
+      gap8.push_back(c.gap_8);
+      ratio.push_back(c.mean_norm_deviation_4 / c.max_norm_deviation_4);
+      max_dev.push_back(c.max_norm_deviation_4);
+      within += c.gap_4 <= 1e-3;
+    }
+    if (seeds > 0) {
+      std::printf("%d key sets (min / median / max): gap with 4 frames %s %% (within 0.1 %% in %d), with 8 frames %s %%;\n"
+                  "  max ||q|-1| %s %%; mean/max %s\n",
+                  seeds, spread(gap4, 100).c_str(), within, spread(gap8, 100).c_str(), spread(max_dev, 100).c_str(),
+                  spread(ratio, 1).c_str());
+    }
+  }
+  f.close();
+  if (!f) {
+    std::cerr << "posefair reproduce: writing " << out << " failed\n";
+    return exit_code(ErrorKind::CantCreate);
+  }
+  std::printf("wrote %s\n", out.c_str());
+  return kExitOk;
+}
+
 }  // namespace
 
 void add_reproduce_command(CLI::App& app, int& exit_code) {
@@ -202,6 +267,17 @@ void add_reproduce_command(CLI::App& app, int& exit_code) {
   ls->add_option("--iterations", *iterations, "sweeps per run")->capture_default_str()->check(CLI::Range(1, 100000));
   ls->add_option("--seeds", *seeds, "random sequences averaged per run")->capture_default_str()->check(CLI::Range(1, 1000));
   ls->callback([=, &exit_code] { exit_code = reproduce_lee_shin(*out, *iterations, *seeds); });
+
+  auto* rb = cmd->add_subcommand("ramamoorthi-barr",
+                                 "Ramamoorthi & Barr Section 4: 4 variable frames against the optimum and the norm "
+                                 "deviation, on the example and on seeded random key sets");
+  auto rb_out = std::make_shared<std::string>("ramamoorthi-barr.csv");
+  auto key_sets = std::make_shared<int>(10);
+  rb->add_option("-o,--output", *rb_out, "CSV file to write")->capture_default_str();
+  rb->add_option("--seeds", *key_sets, "random key sets (seeds 1 .. N) besides the example")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
+  rb->callback([=, &exit_code] { exit_code = reproduce_ramamoorthi_barr(*rb_out, *key_sets); });
 }
 
 }  // namespace posefair::tools
