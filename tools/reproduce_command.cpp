@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include "posefair/core/fairing_study.hpp"
 #include "posefair/core/quaternion_spline_example.hpp"
 #include "posefair/core/quaternion_spline_study.hpp"
+#include "posefair/core/sphere_spline_figure6.hpp"
 
 namespace posefair::tools {
 namespace {
@@ -251,6 +253,53 @@ int reproduce_ramamoorthi_barr(const std::filesystem::path& out, int seeds) {
   return kExitOk;
 }
 
+// Rodrigues et al.'s Figure 6: the segment for k = 1, 2, 3 with the corrected v_{i+1}, the
+// construction curves of step 1 (k = 2), and the printed v_{i+1} after projection.
+int reproduce_rodrigues_figure6(const std::filesystem::path& out) {
+  using namespace geometric_splines;
+  std::ofstream f = open_csv(out, "curve,u,x,y,z");
+  if (!f) {
+    std::cerr << "posefair reproduce: cannot write " << out << "\n";
+    return exit_code(ErrorKind::CantCreate);
+  }
+  const Figure6Data d = figure6_data();
+  std::printf("Figure 6 data: p_i.v_i = %.3g; printed v_i+1: p_i+1.v_i+1 = %.3g; corrected (-1/10, ...): %.3g\n",
+              d.p0.dot(d.v0), d.p1.dot(d.v1_printed), d.p1.dot(d.v1_corrected));
+  constexpr int kSamples = 200;
+  auto write = [&](const std::string& name, auto&& point) {
+    double worst = 0.0, length = 0.0;
+    SpherePoint<3> last = point(0.0);
+    for (int i = 0; i <= kSamples; ++i) {
+      const double u = static_cast<double>(i) / kSamples;
+      const SpherePoint<3> x = point(u);
+      worst = std::max(worst, std::abs(x.norm() - 1.0));
+      length += (x - last).norm();
+      last = x;
+      char line[160];
+      std::snprintf(line, sizeof line, "%s,%.4f,%.15g,%.15g,%.15g\n", name.c_str(), u, x.x(), x.y(), x.z());
+      f << line;
+    }
+    std::printf("  %-18s length %.4f, max | |s| - 1 | %.2g\n", name.c_str(), length, worst);
+  };
+  for (int k = 1; k <= 3; ++k) {
+    const SmoothingFunction phi(k);
+    write("s-k" + std::to_string(k), [&](double u) { return sphere_segment<3>(phi, d.p0, d.v0, d.p1, d.v1_corrected, 1.0, u); });
+  }
+  const SmoothingFunction phi2(2);
+  const SpherePoint<3> v1_projected = project_to_tangent<3>(d.p1, d.v1_printed);
+  write("s-k2-printed-v", [&](double u) { return sphere_segment<3>(phi2, d.p0, d.v0, d.p1, v1_projected, 1.0, u); });
+  write("l", [&](double u) { return sphere_geodesic<3>(d.p0, d.v0, u); });
+  write("c", [&](double u) { return sphere_arc<3>(d.p0, d.p1, u); });
+  write("r", [&](double u) { return sphere_geodesic<3>(d.p1, d.v1_corrected, u - 1.0); });
+  f.close();
+  if (!f) {
+    std::cerr << "posefair reproduce: writing " << out << " failed\n";
+    return exit_code(ErrorKind::CantCreate);
+  }
+  std::printf("wrote %s\n", out.c_str());
+  return kExitOk;
+}
+
 }  // namespace
 
 void add_reproduce_command(CLI::App& app, int& exit_code) {
@@ -278,6 +327,13 @@ void add_reproduce_command(CLI::App& app, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));
   rb->callback([=, &exit_code] { exit_code = reproduce_ramamoorthi_barr(*rb_out, *key_sets); });
+
+  auto* fig6 = cmd->add_subcommand("rodrigues-figure6",
+                                   "Rodrigues, Silva Leite & Jakubiak Figure 6: the spline segment on S2 "
+                                   "(corrected v_i+1, ERRATA 3) for k = 1, 2, 3");
+  auto fig6_out = std::make_shared<std::string>("rodrigues-figure6.csv");
+  fig6->add_option("-o,--output", *fig6_out, "CSV file to write")->capture_default_str();
+  fig6->callback([=, &exit_code] { exit_code = reproduce_rodrigues_figure6(*fig6_out); });
 }
 
 }  // namespace posefair::tools
