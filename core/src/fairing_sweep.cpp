@@ -133,6 +133,26 @@ template <class T, int M, bool Corrected, bool WithP> POSEFAIR_LANE_INLINE void 
   judge<T, WithP>(d, i, c);
 }
 
+// W¹ of the current iterate: u_j = log(q_j⁻¹ q_{j+1}), j = 0 … n−2.
+void w1_pass(const SweepData& d, std::size_t n, double* ux, double* uy, double* uz) {
+  constexpr std::size_t W = lanes::kLaneWidth;
+  double* u[3] = {ux, uy, uz};
+  std::size_t j = 0;
+  for (; j + W <= n - 1; j += W)
+    store_vec(u, j, lanes::log(lanes::conjugate_times(quat_at<Lane>(d.q, j), quat_at<Lane>(d.q, j + 1))));
+  for (; j < n - 1; ++j)
+    store_vec(u, j, lanes::log(lanes::conjugate_times(quat_at<double>(d.q, j), quat_at<double>(d.q, j + 1))));
+}
+
+// Interior samples 1 … last, kLaneWidth at a time, the remainder one at a time.
+template <int M, bool Corrected, bool WithP>
+void interior_pass(const SweepData& d, std::size_t last, Checks<Lane>& wide, Checks<double>& narrow) {
+  constexpr std::size_t W = lanes::kLaneWidth;
+  std::size_t i = 1;
+  for (; i + W <= last + 1; i += W) update_interior<Lane, M, Corrected, WithP>(d, i, wide);
+  for (; i <= last; ++i) update_interior<double, M, Corrected, WithP>(d, i, narrow);
+}
+
 template <class T> double reduce_max(const T& v) {
   if constexpr (std::is_same_v<T, double>) {
     return v;
@@ -260,7 +280,6 @@ void FairingSweep::position_ends() {
 }
 
 template <int M, bool Corrected, bool WithP> SweepOutcome FairingSweep::sweep_as() {
-  constexpr std::size_t W = lanes::kLaneWidth;
   const std::size_t n = n_;
   SweepData d{};
   d.q[0] = q_.w.data(), d.q[1] = q_.x.data(), d.q[2] = q_.y.data(), d.q[3] = q_.z.data();
@@ -279,22 +298,14 @@ template <int M, bool Corrected, bool WithP> SweepOutcome FairingSweep::sweep_as
   d.k_outside = k_outside_;
 
   // W¹: u_j = log(q_j⁻¹ q_{j+1}), j = 0 … n−2 (m = 2 needs it only at its two ends).
-  if constexpr (M == 3) {
-    double* u[3] = {ux_.data(), uy_.data(), uz_.data()};
-    std::size_t j = 0;
-    for (; j + W <= n - 1; j += W)
-      store_vec(u, j, lanes::log(lanes::conjugate_times(quat_at<Lane>(d.q, j), quat_at<Lane>(d.q, j + 1))));
-    for (; j < n - 1; ++j)
-      store_vec(u, j, lanes::log(lanes::conjugate_times(quat_at<double>(d.q, j), quat_at<double>(d.q, j + 1))));
-  }
+  if constexpr (M == 3) w1_pass(d, n, ux_.data(), uy_.data(), uz_.data());
 
   // The interior, fused: targets, damping, renormalisation, eq. 20 and movement.
   const std::size_t last = M == 3 ? n - 3 : n - 2;  // interior samples are 1 … last
   Checks<Lane> wide;
   Checks<double> narrow;
-  std::size_t i = 1;
-  for (; i + W <= last + 1; i += W) update_interior<Lane, M, Corrected, WithP>(d, i, wide);
-  for (; i <= last; ++i) update_interior<double, M, Corrected, WithP>(d, i, narrow);
+  // m = 3's interior is the same code for both variants (d.factor differs): one instantiation.
+  interior_pass<M, M == 2 && Corrected, WithP>(d, last, wide, narrow);
 
   rotation_ends<M, Corrected>();
   if constexpr (WithP) position_ends();
