@@ -35,6 +35,7 @@ struct CameraOptions {
   std::string study_dir;
   int study_matrices = 100;
   int study_pairs = 100;
+  int study_batches = 20;
 };
 
 const char* method_name(InterpolationMethod m) {
@@ -205,13 +206,14 @@ int run_study(const CameraOptions& o) {
   std::printf("\n");
   // The paper's 130 of 1000: how much one batch of 1000 varies, with scales drawn uniformly.
   int fewest = 1000, most = 0;
-  for (std::uint64_t batch = 1; batch <= 20; ++batch) {
+  for (std::uint64_t batch = 1; batch <= static_cast<std::uint64_t>(o.study_batches); ++batch) {
     const int failed = large_rotation_study(1000, batch, ScaleDraw::Uniform).sqrt_failed;
     fewest = std::min(fewest, failed);
     most = std::max(most, failed);
   }
-  std::printf("section 3.2: scales uniform, 20 batches of 1000 (seeds 1-20): the bare square root fails on %d to %d\n",
-              fewest, most);
+  if (o.study_batches > 0)
+    std::printf("section 3.2: scales uniform, %d batches of 1000 (seeds 1-%d): the bare square root fails on %d to %d\n",
+                o.study_batches, o.study_batches, fewest, most);
   for (int d = 0; d < 2; ++d) {
     const PathStudy& p = paths[d];
     std::printf("section 5.1 (%s keys): %zu keyframe pairs (%d rejected: rotation >= 90 deg); excess path, mean (median):\n"
@@ -261,6 +263,11 @@ void add_camera_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--study-pairs", o->study_pairs, "study: random keyframe pairs for Section 5.1")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str()
+      ->needs(study);
+  cmd->add_option("--study-batches", o->study_batches,
+                  "study: batches of 1000 large rotations (seeds 1..N) for Section 3.2's spread")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000))
       ->needs(study);
   cmd->callback([o, cmd, &exit_code] {
     if (!o->study_dir.empty()) {

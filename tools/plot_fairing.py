@@ -125,8 +125,9 @@ def plot_curvature(path, out, perturbation):
     fig, ax = plt.subplots(1, 2, figsize=(10, 3.8), sharey=True)
     for a, what, title in zip(ax, ("mean_error_to_input", "mean_error_to_truth"),
                               ("to the noisy input (claim (a))", "to the clean truth")):
+        sweeps = sorted({int(r["iteration"]) for r in rows})
         for order, colour in (("2", "C0"), ("3", "C1")):
-            for k, style in (("100", "--"), ("1000", "-")):
+            for k, style in ((str(sweeps[0]), "--"), (str(sweeps[-1]), "-")):
                 sel = [r for r in rows if r["order"] == order and r["iteration"] == k]
                 a.plot([float(r["truth_angular_acceleration"]) for r in sel], [float(r[what]) for r in sel], colour,
                        ls=style, marker="o", label=f"m={order}, {k} sweeps")

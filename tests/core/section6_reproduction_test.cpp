@@ -112,12 +112,13 @@ TEST(Section6, AtThePerturbationBoundTheLoopStopsEarly) {
   }
 }
 
-// Claim (a) depends on how curved the motion is. Mean error to the input after 1000 sweeps,
-// seeds 1..5: on gentle motion both orders stay inside the perturbation bound, on Section 6's
-// (1 cycle) only m = 3 does, on fast motion neither does.
+// Claim (a) depends on how curved the motion is (Section 6's motion, 1 cycle, is the test above).
+// Mean error to the input, seeds 1..3: on gentle motion (0.25 cycles) even m = 2, the order that
+// drifts, stays inside the perturbation bound after 1000 sweeps; on fast motion (4 cycles) m = 2
+// has left it after 100 sweeps and m = 3 after 400 (0.15; docs/fairing.md: 0.285 after 1000).
 double mean_error_after(int order, double cycles, int sweeps) {
   double e = 0.0;
-  for (std::uint64_t s = 1; s <= 5; ++s) {
+  for (std::uint64_t s = 1; s <= 3; ++s) {
     SyntheticMotionSpec spec;
     spec.seed = s;
     spec.cycles = cycles;
@@ -128,20 +129,19 @@ double mean_error_after(int order, double cycles, int sweeps) {
     p.max_iterations = sweeps;
     const auto r = fair(motion.noisy, p);
     for (std::size_t i = 0; i < motion.noisy.size(); ++i)
-      e += so3::dist(motion.noisy.orientation[i], r.poses.orientation[i]) / (5.0 * static_cast<double>(motion.noisy.size()));
+      e += so3::dist(motion.noisy.orientation[i], r.poses.orientation[i]) / (3.0 * static_cast<double>(motion.noisy.size()));
   }
   return e;
 }
 
 TEST(Section6, ClaimAHoldsOnlyForModeratelyCurvedMotion) {
-  EXPECT_LT(mean_error_after(2, 0.25, 1000), 0.1);
-  EXPECT_LT(mean_error_after(3, 0.25, 1000), 0.1);
-  EXPECT_GT(mean_error_after(2, 1.0, 1000), 0.1);
-  EXPECT_LT(mean_error_after(3, 1.0, 1000), 0.1);
-  EXPECT_GT(mean_error_after(2, 4.0, 1000), 0.1);
-  EXPECT_GT(mean_error_after(3, 4.0, 1000), 0.1);
-  // m = 2 drifts further the more curved the motion.
-  EXPECT_LT(mean_error_after(2, 0.5, 1000), mean_error_after(2, 2.0, 1000));
+  const double gentle_m2 = mean_error_after(2, 0.25, 1000);
+  EXPECT_LT(gentle_m2, 0.1);
+  const double fast_m2 = mean_error_after(2, 4.0, 100);
+  EXPECT_GT(fast_m2, 0.1);
+  EXPECT_GT(mean_error_after(3, 4.0, 400), 0.1);
+  // m = 2 drifts further the more curved the motion, even in a tenth of the sweeps.
+  EXPECT_GT(fast_m2, 2.0 * gentle_m2);
 }
 
 // Claim (c) on the paper's own setup for Figs. 4–8: perturbations within 0.2 rad and 20 mm.

@@ -208,12 +208,11 @@ TEST(ReproduceCommand, WritesEachPapersTables) {
   const std::string fig6 = testing::slurp(dir / "f6.csv");
   EXPECT_EQ(std::count(fig6.begin(), fig6.end(), '\n'), 1 + 7 * 201);
 
-  r = run_posefair("reproduce ramamoorthi-barr --seeds 0 -o '" + (dir / "rb.csv").string() + "'", dir);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_THAT(r.out, HasSubstr("example      5.8669"));
-
-  r = run_posefair("reproduce rodrigues-figure6 -o '" + (dir / "no/such/dir/f.csv").string() + "'", dir);
-  EXPECT_EQ(r.exit_code, 73);
+  // (ramamoorthi-barr's optimisations are tested in core; here only its output error.)
+  for (const char* paper : {"rodrigues-figure6", "ramamoorthi-barr", "lee-shin"}) {
+    r = run_posefair(std::string("reproduce ") + paper + " -o '" + (dir / "no/such/dir/f.csv").string() + "'", dir);
+    EXPECT_EQ(r.exit_code, 73) << paper;
+  }
 }
 
 }  // namespace
