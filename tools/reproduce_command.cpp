@@ -53,6 +53,17 @@ std::filesystem::path beside(const std::filesystem::path& out, const std::string
   return out.parent_path() / (out.stem().string() + "-" + suffix + ".csv");
 }
 
+// Closes a table and says where it went, or why it failed (exit status 73).
+int finish_csv(std::ofstream& f, const std::filesystem::path& out) {
+  f.close();
+  if (!f) {
+    std::cerr << "posefair reproduce: writing " << out << " failed\n";
+    return exit_code(ErrorKind::CantCreate);
+  }
+  std::printf("wrote %s\n", out.c_str());
+  return kExitOk;
+}
+
 std::ofstream open_csv(const std::filesystem::path& path, const char* header) {
   std::ofstream f(path);
   if (f) f << header << "\n";
@@ -246,13 +257,7 @@ int reproduce_ramamoorthi_barr(const std::filesystem::path& out, int seeds) {
                   spread(ratio, 1).c_str());
     }
   }
-  f.close();
-  if (!f) {
-    std::cerr << "posefair reproduce: writing " << out << " failed\n";
-    return exit_code(ErrorKind::CantCreate);
-  }
-  std::printf("wrote %s\n", out.c_str());
-  return kExitOk;
+  return finish_csv(f, out);
 }
 
 // Rodrigues et al.'s Figure 6: the segment for k = 1, 2, 3 with the corrected v_{i+1}, the
@@ -293,13 +298,7 @@ int reproduce_rodrigues_figure6(const std::filesystem::path& out) {
   write("l", [&](double u) { return sphere_geodesic<3>(d.p0, d.v0, u); });
   write("c", [&](double u) { return sphere_arc<3>(d.p0, d.p1, u); });
   write("r", [&](double u) { return sphere_geodesic<3>(d.p1, d.v1_corrected, u - 1.0); });
-  f.close();
-  if (!f) {
-    std::cerr << "posefair reproduce: writing " << out << " failed\n";
-    return exit_code(ErrorKind::CantCreate);
-  }
-  std::printf("wrote %s\n", out.c_str());
-  return kExitOk;
+  return finish_csv(f, out);
 }
 
 }  // namespace

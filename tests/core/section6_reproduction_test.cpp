@@ -144,11 +144,17 @@ TEST(Section6, ClaimAHoldsOnlyForModeratelyCurvedMotion) {
   EXPECT_GT(fast_m2, 2.0 * gentle_m2);
 }
 
-// Claim (c) on the paper's own setup for Figs. 4–8: perturbations within 0.2 rad and 20 mm.
-TEST(Section6, AccelerationFallsFastOnTheSetupOfFigures4To8) {
+// The paper's own setup for Figs. 4–8: perturbations within 0.2 rad and 20 mm.
+SyntheticMotionSpec figures_4_to_8_spec() {
   SyntheticMotionSpec spec;
   spec.rotation_noise = 0.2;
   spec.position_noise = 20.0;
+  return spec;
+}
+
+// Claim (c) on that setup.
+TEST(Section6, AccelerationFallsFastOnTheSetupOfFigures4To8) {
+  const SyntheticMotionSpec spec = figures_4_to_8_spec();
   FairingParams p;
   p.max_iterations = 100;
   const auto m3 = posefair::mean_trace(spec, 5, p);
@@ -162,9 +168,7 @@ TEST(Section6, AccelerationFallsFastOnTheSetupOfFigures4To8) {
 // Figures 6–8: translational fairing smooths the path and leaves the orientations as measured;
 // the final motion is also smoother in rotation.
 TEST(Section6, TheMotionsOfFigures6To8) {
-  SyntheticMotionSpec spec;
-  spec.rotation_noise = 0.2;
-  spec.position_noise = 20.0;
+  const SyntheticMotionSpec spec = figures_4_to_8_spec();
   FairingParams p;
   p.max_iterations = 100;
   const auto st = faired_motion_stages(spec, p);
