@@ -7,6 +7,7 @@ target_sources(posefair_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/src/covariant_acceleration.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/quaternion_spline_objective.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/quaternion_spline.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/quaternion_spline_study.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/sampled_rotation_energy.cpp
 )
 target_link_libraries(posefair_core PUBLIC NLopt::nlopt)

@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +14,7 @@
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <utility>
 
 #include "camera_keyframe_file.hpp"
 #include "posefair/core/error.hpp"
@@ -33,6 +35,7 @@ struct CameraOptions {
   std::string study_dir;
   int study_matrices = 100;
   int study_pairs = 100;
+  int study_batches = 20;
 };
 
 const char* method_name(InterpolationMethod m) {
@@ -166,21 +169,63 @@ int run_study(const CameraOptions& o) {
     for (const auto& r : log_square_root_study(n, 30, eps3, eps3 < 1e-9, 42))
       lg << eps3 << "," << r.matrix << "," << r.square_roots << "," << r.distance_to_identity << "," << r.series_terms
          << "," << r.change << "," << r.error << "\n";
-  const auto p = path_length_study(o.study_pairs, 42);
-  pl << "pair,rotation_deg,excess_parameter,excess_matrix,vertices_used\n";
-  for (const auto& r : p.pairs)
-    pl << r.pair << "," << r.rotation_deg << "," << r.excess_parameter << "," << r.excess_matrix << ","
-       << r.vertices_used << "\n";
-  const auto big = large_rotation_study(1000, 42);
-  std::printf("section 3.2: %d transforms with rotations in [pi/2, pi] and non-uniform scale: %d have a negative real\n"
-              "             eigenvalue (no real log), the bare square root fails on %d (%d of them with a principal root);\n"
-              "             matrix_log succeeds on %d (%d hit a cap), worst relative error vs Eigen %.3g\n",
-              big.matrices, big.negative_eigenvalue, big.sqrt_failed, big.sqrt_failed_without_negative, big.log_ok, big.log_root_cap,
-              big.worst_log_error);
-  std::printf("section 5.1: %zu keyframe pairs (%d rejected: rotation >= 90 deg), %d vertex paths skipped;\n"
-              "             excess path mean %.2f%% (median %.2f%%) camera-parameter vs %.2f%% (median %.2f%%) matrix\n",
-              p.pairs.size(), p.rejected_unsafe, p.vertices_skipped, p.mean_parameter, p.median_parameter,
-              p.mean_matrix, p.median_matrix);
+  pl << "draw,pair,drawn_angle_deg,rotation_deg,camera_parameter,camera_matrix,screen_parameter,screen_matrix,"
+        "camera_vertices,screen_vertices\n";
+  PathStudy paths[2];
+  const std::pair<KeyPairDraw, const char*> draws[] = {{KeyPairDraw::UniformAngle, "uniform-angle"},
+                                                       {KeyPairDraw::Independent, "independent"}};
+  for (int d = 0; d < 2; ++d) {
+    paths[d] = path_length_study(o.study_pairs, 42, draws[d].first);
+    for (const auto& r : paths[d].pairs)
+      pl << draws[d].second << "," << r.pair << "," << r.drawn_angle_deg << "," << r.rotation_deg << ","
+         << r.camera_parameter << "," << r.camera_matrix << "," << r.screen_parameter << "," << r.screen_matrix << ","
+         << r.camera_vertices << "," << r.screen_vertices << "\n";
+  }
+  for (const auto& [scales, name] : {std::pair{ScaleDraw::LogUniform, "log-uniform"}, std::pair{ScaleDraw::Uniform, "uniform"}}) {
+    const auto big = large_rotation_study(1000, 42, scales);
+    std::printf("section 3.2: %d transforms with rotations in [pi/2, pi], scales %s in [1e-2, 1e2]: %d have a negative\n"
+                "             real eigenvalue (no real log), the bare square root fails on %d (%d of them with a principal\n"
+                "             root); matrix_log succeeds on %d (%d hit a cap), worst relative error vs Eigen %.3g\n",
+                big.matrices, name, big.negative_eigenvalue, big.sqrt_failed, big.sqrt_failed_without_negative, big.log_ok,
+                big.log_root_cap, big.worst_log_error);
+  }
+  // The uniform-angle pairs by turn: how the excess grows with the angle.
+  std::printf("section 5.1 (uniform-angle keys) by turn, camera space, mean excess parameter vs matrix:");
+  for (int lo = 0; lo < 90; lo += 30) {
+    double sp = 0.0, sm = 0.0;
+    int count = 0;
+    for (const auto& r : paths[0].pairs) {
+      if (r.drawn_angle_deg < lo || r.drawn_angle_deg >= lo + 30) continue;
+      sp += r.camera_parameter;
+      sm += r.camera_matrix;
+      ++count;
+    }
+    std::printf("  %d-%d deg (%d pairs) %.1f%% vs %.2f%%", lo, lo + 30, count, count ? sp / count : 0.0,
+                count ? sm / count : 0.0);
+  }
+  std::printf("\n");
+  // The paper's 130 of 1000: how much one batch of 1000 varies, with scales drawn uniformly.
+  int fewest = 1000, most = 0;
+  for (std::uint64_t batch = 1; batch <= static_cast<std::uint64_t>(o.study_batches); ++batch) {
+    const int failed = large_rotation_study(1000, batch, ScaleDraw::Uniform).sqrt_failed;
+    fewest = std::min(fewest, failed);
+    most = std::max(most, failed);
+  }
+  if (o.study_batches > 0)
+    std::printf("section 3.2: scales uniform, %d batches of 1000 (seeds 1-%d): the bare square root fails on %d to %d\n",
+                o.study_batches, o.study_batches, fewest, most);
+  for (int d = 0; d < 2; ++d) {
+    const PathStudy& p = paths[d];
+    std::printf("section 5.1 (%s keys): %zu keyframe pairs (%d rejected: rotation >= 90 deg); excess path, mean (median):\n"
+                "             camera space: %.2f%% (%.2f%%) camera-parameter vs %.2f%% (%.2f%%) matrix, lower in %d pairs"
+                " (%d vertex paths skipped)\n"
+                "             screen:       %.2f%% (%.2f%%) camera-parameter vs %.2f%% (%.2f%%) matrix, lower in %d pairs"
+                " (%d vertex paths skipped)\n",
+                draws[d].second, p.pairs.size(), p.rejected_unsafe, p.camera.mean_parameter, p.camera.median_parameter,
+                p.camera.mean_matrix, p.camera.median_matrix, p.camera.matrix_lower, p.camera_skipped,
+                p.screen.mean_parameter, p.screen.median_parameter, p.screen.mean_matrix, p.screen.median_matrix,
+                p.screen.matrix_lower, p.screen_skipped);
+  }
   std::printf("wrote    %s/{sqrt_iterations,log_square_roots,path_length}.csv\n", o.study_dir.c_str());
   return (sq && lg && pl) ? kExitOk : exit_code(ErrorKind::CantCreate);
 }
@@ -218,6 +263,11 @@ void add_camera_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--study-pairs", o->study_pairs, "study: random keyframe pairs for Section 5.1")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str()
+      ->needs(study);
+  cmd->add_option("--study-batches", o->study_batches,
+                  "study: batches of 1000 large rotations (seeds 1..N) for Section 3.2's spread")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000))
       ->needs(study);
   cmd->callback([o, cmd, &exit_code] {
     if (!o->study_dir.empty()) {

@@ -86,18 +86,22 @@ def plot_log(study, out):
 
 
 def plot_paths(study, out):
-    rs = rows(study / "path_length.csv")
-    rot = [num(r["rotation_deg"]) for r in rs]
-    p = [num(r["excess_parameter"]) for r in rs]
-    m = [num(r["excess_matrix"]) for r in rs]
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    ax.scatter(rot, p, s=12, color="tab:red", label="camera-parameter interpolation")
-    ax.scatter(rot, m, s=12, color="tab:blue", label="matrix interpolation (eq. 7)")
-    ax.set_yscale("symlog", linthresh=1)
-    ax.set_xlabel("rotation between the keyframes (degrees)")
-    ax.set_ylabel("mean excess screen path 100 (l - l0)/l0 (%)")
-    ax.set_title("Section 5.1: excess path of mesh vertices per keyframe pair")
-    ax.legend()
+    """Section 5.1 on the uniform-angle key pairs: camera space (the paper's measure) and the
+    screen, against the turn drawn, with the arc-over-chord floor of a pure turn."""
+    rs = [r for r in rows(study / "path_length.csv") if r["draw"] == "uniform-angle"]
+    angle = [num(r["drawn_angle_deg"]) for r in rs]
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.3), sharey=True)
+    for a, space, title in ((ax[0], "camera", "camera space (Fig. 8's measure)"), (ax[1], "screen", "screen (x, y after the divide)")):
+        a.scatter(angle, [num(r[space + "_parameter"]) for r in rs], s=12, color="tab:red", label="camera-parameter interpolation")
+        a.scatter(angle, [num(r[space + "_matrix"]) for r in rs], s=12, color="tab:blue", label="matrix interpolation (eq. 7)")
+        th = [0.5 + i for i in range(90)]
+        a.plot(th, [100 * ((math.radians(t) / 2) / math.sin(math.radians(t) / 2) - 1) for t in th], color="gray", ls=":",
+               label="arc over chord of the turn")
+        a.set_yscale("symlog", linthresh=1)
+        a.set_xlabel("turn between the keyframes, drawn uniformly in [0, 90) (degrees)")
+        a.set_title("Section 5.1: excess path, " + title, fontsize=10)
+        a.legend(fontsize=8)
+    ax[0].set_ylabel("mean excess path 100 (l - l0)/l0 (%)")
     fig.tight_layout()
     fig.savefig(out / "matrix-interpolation-path-length.png", dpi=110)
 

@@ -10,6 +10,11 @@ Data: BROAD trial 07 (fast rotation; Laidig et al. 2021, CC BY 4.0). The script 
 `posefair resample --rate 1000 --order k --derivatives` on it for k = 1, 2, 3 (the C++ code
 writes the body-frame angular velocity and acceleration CSV), and plots those against the
 trial's own 285.7 Hz gyroscope. Needs python3-matplotlib.
+
+    build/tools/posefair reproduce rodrigues-figure6 -o build/rodrigues-figure6.csv
+    /usr/bin/python3 tools/plot_splines.py --figure6 build/rodrigues-figure6.csv docs/img
+
+draws the paper's Figure 6 (docs/img/splines-figure6.png) from that command's curves instead.
 """
 import csv
 import os
@@ -29,7 +34,55 @@ DATA = DATA_DIR / "broad/07_undisturbed_fast_rotation_B.csv"
 START, LENGTH, DECIMATE = 30.0, 3.0, 10
 
 
+def plot_figure6(path, out_dir):
+    """The segment s_i of Figure 6 on S² for k = 1, 2, 3 (corrected v_{i+1}), the step-1 curves
+    l, c, r it blends, and the velocities at both ends."""
+    curves = {}
+    with open(path, newline="") as f:
+        for r in csv.DictReader(f):
+            curves.setdefault(r["curve"], []).append((float(r["x"]), float(r["y"]), float(r["z"])))
+    fig = plt.figure(figsize=(7, 6.5))
+    a = fig.add_subplot(projection="3d")
+    import math
+    n = 24
+    for i in range(n + 1):  # a wire sphere: meridians and parallels
+        th = math.pi * i / n
+        a.plot([math.sin(th) * math.cos(2 * math.pi * j / 96) for j in range(97)],
+               [math.sin(th) * math.sin(2 * math.pi * j / 96) for j in range(97)], [math.cos(th)] * 97,
+               color="0.85", lw=0.4)
+    for i in range(n):
+        ph = 2 * math.pi * i / n
+        a.plot([math.sin(math.pi * j / 48) * math.cos(ph) for j in range(49)],
+               [math.sin(math.pi * j / 48) * math.sin(ph) for j in range(49)], [math.cos(math.pi * j / 48) for j in range(49)],
+               color="0.85", lw=0.4)
+    styles = {"l": ("C7", ":", "l (geodesic from p_i, v_i)"), "c": ("C7", "--", "c (great arc p_i to p_i+1)"),
+              "r": ("C7", "-.", "r (geodesic into p_i+1, v_i+1)"),
+              "s-k1": ("C0", "-", "s_i, k = 1"), "s-k2": ("C3", "-", "s_i, k = 2 (the paper's natural spline)"),
+              "s-k3": ("C2", "-", "s_i, k = 3"), "s-k2-printed-v": ("C1", (0, (1, 1)), "k = 2, printed v_i+1 projected")}
+    for name, (colour, ls, label) in styles.items():
+        pts = curves[name]
+        a.plot(*zip(*pts), color=colour, ls=ls, lw=1.8 if name.startswith("s-") else 1.0, label=label)
+    p0, p1 = curves["s-k2"][0], curves["s-k2"][-1]
+    r3 = 3 ** 0.5
+    for p, v in ((p0, (0.5, r3, 3 - r3)), (p1, (-0.1, 1.8, (9 * r3 - 1) / 15))):
+        a.quiver(*p, *[0.3 * c for c in v], color="k", arrow_length_ratio=0.15)
+    a.scatter(*zip(p0, p1), color="k", s=20)
+    a.text(*p0, "  p_i", fontsize=9)
+    a.text(*p1, "  p_i+1", fontsize=9)
+    a.set_box_aspect((1, 1, 1))
+    a.view_init(elev=20, azim=20)
+    a.set_title("Figure 6: segment s_i on S² (v_i+1 with first component −1/10, ERRATA 3)", fontsize=10)
+    a.legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(Path(out_dir) / "splines-figure6.png", dpi=110)
+    plt.close(fig)
+    print("wrote", Path(out_dir) / "splines-figure6.png")
+
+
 def main():
+    if sys.argv[1] == "--figure6":
+        plot_figure6(sys.argv[2], sys.argv[3])
+        return
     posefair, out_dir = Path(sys.argv[1]), Path(sys.argv[2])
     data = sys.argv[3] if len(sys.argv) > 3 else DATA
     if not Path(data).exists():

@@ -140,13 +140,29 @@ Result<std::vector<Mat4>> interpolate_cameras(InterpolationMethod method, std::s
   return m;
 }
 
-Mat4 camera_parameter_lerp_matrix(const CameraParams& a, const CameraParams& b, double t) {
+namespace {
+// The interpolated parameters: lens, rotation and position.
+struct LerpedCamera {
+  CameraIntrinsics lens;
+  Matrix3d rotation;
+  Vector3d from;
+};
+LerpedCamera lerp_camera(const CameraParams& a, const CameraParams& b, double t) {
   const Vector3d ea = euler_zyx(look_at_rotation(a.from, a.at, a.up).transpose());
   const Vector3d eb = euler_zyx(look_at_rotation(b.from, b.at, b.up).transpose());
   const Vector3d e(lerp_angle(ea[0], eb[0], t), lerp(ea[1], eb[1], t), lerp_angle(ea[2], eb[2], t));
-  const CameraIntrinsics lens = lerp_lens(a.lens, b.lens, t);
-  const Vector3d from = (1.0 - t) * a.from + t * b.from;
-  return perspective_matrix(lens) * view_part(lens, from_euler_zyx(e).transpose(), from);
+  return {lerp_lens(a.lens, b.lens, t), from_euler_zyx(e).transpose(), (1.0 - t) * a.from + t * b.from};
+}
+}  // namespace
+
+Mat4 camera_parameter_lerp_matrix(const CameraParams& a, const CameraParams& b, double t) {
+  const LerpedCamera c = lerp_camera(a, b, t);
+  return perspective_matrix(c.lens) * view_part(c.lens, c.rotation, c.from);
+}
+
+Mat4 camera_parameter_lerp_affine(const CameraParams& a, const CameraParams& b, double t) {
+  const LerpedCamera c = lerp_camera(a, b, t);
+  return perspective_b(c.lens) * view_part(c.lens, c.rotation, c.from);
 }
 
 }  // namespace posefair

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "posefair/core/difference_operators.hpp"
+#include "posefair/core/fairing_sweep.hpp"
 
 namespace posefair {
 
@@ -49,46 +50,38 @@ FairingResult fair(const PoseSequence& input, const FairingParams& params, const
   so3::make_continuous(q0);
   const std::vector<Vec3>& p0 = input.position;
 
-  std::vector<Quat> q = q0, q_next(n), q_target(n);
-  std::vector<Vec3> u(n - 1);
-  std::vector<Vec3> p = p0, p_next(with_p ? n : 0), p_target(with_p ? n : 0);
-
   FairingResult r;
   r.rotational_energy_before = rotational_energy(q0, m);
   if (with_p) r.translational_energy_before = translational_energy(p0, m);
 
+  // The sweeps run on arrays of components (fairing_sweep.hpp); quaternions are built only
+  // for an observer and for the result.
+  FairingSweep sweep(params, q0, p0);
+  std::vector<Quat> q;
+  std::vector<Vec3> p;
   r.stop = StopReason::IterationCap;
   for (int k = 0; k < params.max_iterations; ++k) {
-    q_next = q;
-    damped_rotation_sweep(m, params.variant, params.lambda_r, q_next, u, q_target);
-    if (with_p) {
-      p_next = p;
-      damped_position_sweep(m, params.lambda_t, p_next, p_target);
-    }
     // Eq. 20 on the candidate: reject it (keep the last good iterate) if any sample breaks it.
-    bool within = true;
-    double step = 0.0;
-    for (std::size_t i = 0; i < n && within; ++i) {
-      within = so3::dist(q0[i], q_next[i]) < params.epsilon_r &&
-               (!with_p || (p_next[i] - p0[i]).norm() < params.epsilon_t);
-    }
-    if (!within) {
+    const SweepOutcome o = sweep.sweep();
+    if (!o.within) {
       r.stop = StopReason::Bound;
       break;
     }
-    for (std::size_t i = 0; i < n; ++i) {
-      step = std::max(step, so3::dist(q[i], q_next[i]));
-      if (with_p) step = std::max(step, (p_next[i] - p[i]).norm());
-    }
-    q.swap(q_next);
-    if (with_p) p.swap(p_next);
+    // With no tolerance only a sweep that moves nothing converges; the exact step is needed
+    // only to compare it with a tolerance.
+    const bool converged = params.step_tolerance > 0.0 ? sweep.step() <= params.step_tolerance : !o.moved;
+    sweep.accept();
     r.iterations = k + 1;
-    if (observer) observer(r.iterations, q, p);
-    if (step <= params.step_tolerance) {
+    if (observer) {
+      sweep.current(q, p);
+      observer(r.iterations, q, p);
+    }
+    if (converged) {
       r.stop = StopReason::Converged;
       break;
     }
   }
+  sweep.current(q, p);
 
   r.rotational_energy_after = rotational_energy(q, m);
   if (with_p) r.translational_energy_after = translational_energy(p, m);

@@ -1,11 +1,19 @@
 #include "posefair/core/fairing_study.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include "posefair/core/difference_operators.hpp"
 
 namespace posefair {
 namespace {
+
+double angular_acceleration(std::span<const Quat> q, double dt) {
+  const auto w2 = orientation_differences(q, 2);
+  double a = 0.0;
+  for (const Vec3& w : w2) a += 2.0 * w.norm() / static_cast<double>(w2.size()) / (dt * dt);
+  return a;
+}
 
 FairingTracePoint measure(int k, const SyntheticMotion& motion, std::span<const Quat> q,
                           std::span<const Vec3> p, int order) {
@@ -19,8 +27,7 @@ FairingTracePoint measure(int k, const SyntheticMotion& motion, std::span<const 
     t.mean_error_to_truth += so3::dist(motion.truth.orientation[i], q[i]) / static_cast<double>(n);
   }
   const double dt = motion.noisy.time.size() > 1 ? motion.noisy.time[1] - motion.noisy.time[0] : 1.0;
-  const auto w2 = orientation_differences(q, 2);
-  for (const Vec3& w : w2) t.mean_angular_acceleration += 2.0 * w.norm() / static_cast<double>(w2.size()) / (dt * dt);
+  t.mean_angular_acceleration = angular_acceleration(q, dt);
   t.rotational_energy = rotational_energy(q, order);
   if (!p.empty()) {
     for (std::size_t i = 0; i < n; ++i)
@@ -32,6 +39,50 @@ FairingTracePoint measure(int k, const SyntheticMotion& motion, std::span<const 
 }
 
 }  // namespace
+
+double mean_angular_acceleration(const PoseSequence& poses) {
+  std::vector<Quat> q = poses.orientation;
+  so3::make_continuous(q);
+  return angular_acceleration(q, poses.time.size() > 1 ? poses.time[1] - poses.time[0] : 1.0);
+}
+
+std::vector<BoundedRun> bounded_runs(const SyntheticMotionSpec& spec, int seeds, const FairingParams& params) {
+  std::vector<BoundedRun> runs;
+  for (int s = 1; s <= seeds; ++s) {
+    SyntheticMotionSpec one = spec;
+    one.seed = static_cast<std::uint64_t>(s);
+    const SyntheticMotion motion = make_synthetic_motion(one);
+    const FairingResult r = fair(motion.noisy, params);
+    BoundedRun run{s, r.iterations, r.stop, 0, 0, -1};
+    if (r.stop == StopReason::Bound) {
+      // The iterate the loop refused: one sweep more, without the bounds.
+      FairingParams free = params;
+      free.epsilon_r = free.epsilon_t = std::numeric_limits<double>::infinity();
+      free.max_iterations = r.iterations + 1;
+      const FairingResult next = fair(motion.noisy, free);
+      for (std::size_t i = 0; i < motion.noisy.size(); ++i) {
+        const bool rot = !(so3::dist(motion.noisy.orientation[i], next.poses.orientation[i]) < params.epsilon_r);
+        const bool pos = motion.noisy.has_position() &&
+                         !((next.poses.position[i] - motion.noisy.position[i]).norm() < params.epsilon_t);
+        run.breaking_rotation += rot;
+        run.breaking_position += pos;
+        if ((rot || pos) && run.first_breaking < 0) run.first_breaking = static_cast<std::ptrdiff_t>(i);
+      }
+    }
+    runs.push_back(run);
+  }
+  return runs;
+}
+
+FairedMotionStages faired_motion_stages(const SyntheticMotionSpec& spec, const FairingParams& params) {
+  const SyntheticMotion motion = make_synthetic_motion(spec);
+  FairedMotionStages st{motion.truth, motion.noisy, motion.noisy, {}};
+  st.faired = fair(motion.noisy, params).poses;
+  // Translation and rotation sweeps do not interact: the positions of the full run are those
+  // of fairing positions alone.
+  st.translation_faired.position = st.faired.position;
+  return st;
+}
 
 std::vector<FairingTracePoint> trace_fairing(const SyntheticMotion& motion, const FairingParams& params) {
   std::vector<FairingTracePoint> trace;

@@ -70,13 +70,19 @@ double median(std::vector<double> x) {
 
 }  // namespace
 
-Mat4 random_test_transform(std::mt19937_64& rng, double min_angle, double max_angle) {
-  std::uniform_real_distribution<double> angle(min_angle, max_angle), log_scale(-2.0, 2.0), shift(0.1, 100.0);
+Mat4 random_test_transform(std::mt19937_64& rng, double min_angle, double max_angle, ScaleDraw scales) {
+  std::uniform_real_distribution<double> angle(min_angle, max_angle), log_scale(-2.0, 2.0), scale(1e-2, 1e2),
+      shift(0.1, 100.0);
   const Eigen::Matrix3d r = (Eigen::AngleAxisd(angle(rng), Vector3d::UnitZ()) *
                              Eigen::AngleAxisd(angle(rng), Vector3d::UnitY()) *
                              Eigen::AngleAxisd(angle(rng), Vector3d::UnitX()))
                                 .toRotationMatrix();
-  const Vector3d s(std::pow(10.0, log_scale(rng)), std::pow(10.0, log_scale(rng)), std::pow(10.0, log_scale(rng)));
+  // (Kept as one expression per draw: the order in which the three draws are made is the
+  // compiler's, and the documented numbers were made with it.)
+  const Vector3d s = scales == ScaleDraw::LogUniform
+                         ? Vector3d(std::pow(10.0, log_scale(rng)), std::pow(10.0, log_scale(rng)),
+                                    std::pow(10.0, log_scale(rng)))
+                         : Vector3d(scale(rng), scale(rng), scale(rng));
   Mat4 m = Mat4::Identity();
   m.topLeftCorner<3, 3>() = r * s.asDiagonal();
   m.topRightCorner<3, 1>() = Vector3d(shift(rng), shift(rng), shift(rng));
@@ -142,14 +148,14 @@ std::vector<LogStudyRow> log_square_root_study(int matrices, int max_roots, doub
   return rows;
 }
 
-LargeRotationStudy large_rotation_study(int matrices, std::uint64_t seed) {
+LargeRotationStudy large_rotation_study(int matrices, std::uint64_t seed, ScaleDraw scales) {
   std::mt19937_64 rng(seed);
   LargeRotationStudy s;
   s.matrices = matrices;
   for (int m = 0; m < matrices; ++m) {
     // The composite rotation matters (Rz(pi) Ry(pi) Rx(pi) = I): keep those of pi/2 or more.
     Mat4 a;
-    do a = random_test_transform(rng);
+    do a = random_test_transform(rng, 0.0, std::numbers::pi, scales);
     while (rotational_component(a) < std::numbers::pi / 2.0);
     const bool negative = !has_principal_log(a);
     const bool sqrt_ok = denman_beavers_sqrt(a).ok();
@@ -166,14 +172,25 @@ LargeRotationStudy large_rotation_study(int matrices, std::uint64_t seed) {
   return s;
 }
 
-PathStudy path_length_study(int pairs, std::uint64_t seed) {
+PathStudy path_length_study(int pairs, std::uint64_t seed, KeyPairDraw draw) {
   std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
   const std::vector<Vector3d> mesh = sphere_mesh(8, 16);
   PathStudy s;
-  std::vector<double> par, mat;
   const int steps = 10;
   while (static_cast<int>(s.pairs.size()) < pairs) {
-    const CameraParams a = random_camera(rng), b = random_camera(rng);
+    const CameraParams a = random_camera(rng);
+    CameraParams b = random_camera(rng);  // its lens (and, for Independent, everything)
+    double drawn = kNaN;
+    if (draw == KeyPairDraw::UniformAngle) {
+      // Turn a's whole view by the angle about a random axis: b's view rotation is then a's
+      // times that turn; its distance to the looked-at point is b's own.
+      drawn = 0.5 * std::numbers::pi * u01(rng);
+      const Eigen::Matrix3d g = Eigen::AngleAxisd(drawn, random_unit(rng)).toRotationMatrix();
+      b.at = g * a.at;
+      b.up = g * a.up;
+      b.from = b.at + g * (a.from - a.at).normalized() * (b.from - b.at).norm();
+    }
     const CameraKey ka = camera_key(a), kb = camera_key(b);
     const double rot = rotational_component(kb.origin * ka.origin.inverse());
     Result<PreparedLerp> lerp = PreparedLerp::make(ka.matrix, kb.matrix, ka.origin);
@@ -181,56 +198,80 @@ PathStudy path_length_study(int pairs, std::uint64_t seed) {
       ++s.rejected_unsafe;
       continue;
     }
-    // Screen paths of every vertex under both methods.
-    std::vector<std::vector<Eigen::Vector2d>> path_p(mesh.size()), path_m(mesh.size());
-    std::vector<bool> usable(mesh.size(), true);
+    // Paths of every vertex under both methods, in camera space and on the screen.
+    const std::size_t nv = mesh.size();
+    std::vector<std::vector<Vector3d>> cam_p(nv), cam_m(nv);
+    std::vector<std::vector<Eigen::Vector2d>> scr_p(nv), scr_m(nv);
+    std::vector<bool> in_front(nv, true);
     for (int i = 0; i <= steps; ++i) {
       const double t = static_cast<double>(i) / steps;
-      const Mat4 cp = camera_parameter_lerp_matrix(a, b, t);
-      MatrixResult m = lerp.value().at(t);
-      const Mat4 cm = perspective_a((1.0 - t) * ka.k + t * kb.k) * m.value();
-      for (std::size_t v = 0; v < mesh.size(); ++v) {
+      const Mat4 ap = camera_parameter_lerp_affine(a, b, t), cp = camera_parameter_lerp_matrix(a, b, t);
+      const Mat4 am = lerp.value().at(t).value(), cm = perspective_a((1.0 - t) * ka.k + t * kb.k) * am;
+      for (std::size_t v = 0; v < nv; ++v) {
         const Eigen::Vector4d h(mesh[v].x(), mesh[v].y(), mesh[v].z(), 1.0);
+        cam_p[v].push_back((ap * h).head<3>());
+        cam_m[v].push_back((am * h).head<3>());
         const Eigen::Vector4d qp = cp * h, qm = cm * h;
-        if (qp.w() <= 0.0 || qm.w() <= 0.0) usable[v] = false;
-        path_p[v].push_back(qp.head<2>() / qp.w());
-        path_m[v].push_back(qm.head<2>() / qm.w());
+        if (qp.w() <= 0.0 || qm.w() <= 0.0) in_front[v] = false;
+        scr_p[v].push_back(qp.head<2>() / qp.w());
+        scr_m[v].push_back(qm.head<2>() / qm.w());
       }
     }
-    auto length = [](const std::vector<Eigen::Vector2d>& p) {
+    auto length = [](const auto& p) {
       double l = 0.0;
       for (std::size_t i = 1; i < p.size(); ++i) l += (p[i] - p[i - 1]).norm();
       return l;
     };
-    double sum_p = 0.0, sum_m = 0.0;
-    int used = 0;
-    for (std::size_t v = 0; v < mesh.size(); ++v) {
-      const double l0 = (path_p[v].back() - path_p[v].front()).norm();
-      if (!usable[v] || l0 < 0.01) {
-        ++s.vertices_skipped;
-        continue;
+    // The mesh's radius in camera space at key a: the scale for "did not move".
+    double radius = 0.0;
+    const Vector3d centre = (ka.matrix * Eigen::Vector4d(0, 0, 0, 1)).head<3>();
+    for (std::size_t v = 0; v < nv; ++v) radius = std::max(radius, (cam_m[v].front() - centre).norm());
+    // Mean excess over the usable vertices; both methods start and end at the keys, so l0 is shared.
+    auto excess = [&](const auto& path_p, const auto& path_m, double min_l0, bool screen, int& skipped, int& used,
+                      double& ex_p, double& ex_m) {
+      double sum_p = 0.0, sum_m = 0.0;
+      used = 0;
+      for (std::size_t v = 0; v < nv; ++v) {
+        const double l0 = (path_p[v].back() - path_p[v].front()).norm();
+        if ((screen && !in_front[v]) || l0 < min_l0) {
+          ++skipped;
+          continue;
+        }
+        sum_p += 100.0 * (length(path_p[v]) - l0) / l0;
+        sum_m += 100.0 * (length(path_m[v]) - l0) / l0;
+        ++used;
       }
-      // Both methods start and end at the keyframes, so l0 is the same for both.
-      sum_p += 100.0 * (length(path_p[v]) - l0) / l0;
-      sum_m += 100.0 * (length(path_m[v]) - l0) / l0;
-      ++used;
-    }
-    if (used == 0) continue;
-    PathPairRow row{static_cast<int>(s.pairs.size()), rot * 180.0 / std::numbers::pi, sum_p / used, sum_m / used,
-                    used};
+      ex_p = used ? sum_p / used : kNaN;
+      ex_m = used ? sum_m / used : kNaN;
+    };
+    PathPairRow row{static_cast<int>(s.pairs.size()), drawn * 180.0 / std::numbers::pi, rot * 180.0 / std::numbers::pi,
+                    kNaN, kNaN, kNaN, kNaN, 0, 0};
+    int cam_skipped = 0, scr_skipped = 0;
+    excess(cam_p, cam_m, 1e-3 * radius, false, cam_skipped, row.camera_vertices, row.camera_parameter, row.camera_matrix);
+    excess(scr_p, scr_m, 0.01, true, scr_skipped, row.screen_vertices, row.screen_parameter, row.screen_matrix);
+    if (row.camera_vertices == 0 || row.screen_vertices == 0) continue;
+    s.camera_skipped += cam_skipped;
+    s.screen_skipped += scr_skipped;
     s.pairs.push_back(row);
-    par.push_back(row.excess_parameter);
-    mat.push_back(row.excess_matrix);
   }
-  double mp = 0.0, mm = 0.0;
-  for (std::size_t i = 0; i < par.size(); ++i) {
-    mp += par[i];
-    mm += mat[i];
-  }
-  s.mean_parameter = par.empty() ? kNaN : mp / par.size();
-  s.mean_matrix = mat.empty() ? kNaN : mm / mat.size();
-  s.median_parameter = median(par);
-  s.median_matrix = median(mat);
+  auto summarise = [&](double PathPairRow::*par, double PathPairRow::*mat) {
+    PathMeans m;
+    std::vector<double> p, q;
+    for (const PathPairRow& r : s.pairs) {
+      p.push_back(r.*par);
+      q.push_back(r.*mat);
+      m.matrix_lower += r.*mat < r.*par;
+    }
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      m.mean_parameter += p[i] / static_cast<double>(p.size());
+      m.mean_matrix += q[i] / static_cast<double>(q.size());
+    }
+    m.median_parameter = median(p);
+    m.median_matrix = median(q);
+    return m;
+  };
+  s.camera = summarise(&PathPairRow::camera_parameter, &PathPairRow::camera_matrix);
+  s.screen = summarise(&PathPairRow::screen_parameter, &PathPairRow::screen_matrix);
   return s;
 }
 

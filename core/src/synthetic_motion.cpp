@@ -23,7 +23,7 @@ SyntheticMotion make_synthetic_motion(const SyntheticMotionSpec& spec) {
   std::uniform_real_distribution<double> uni(0.0, 1.0);
   constexpr double two_pi = 2.0 * std::numbers::pi;
 
-  // Three sine components per axis with random frequency, amplitude and phase; the truth is
+  // Two sine components per axis with random frequency, amplitude and phase; the truth is
   // exp(a(s)) with s = i/(n-1) ∈ [0, 1], smooth at every scale the noise lives on.
   struct Wave { double amp, freq, phase; };
   Wave rot[3][2], pos[3][2];

@@ -1,11 +1,14 @@
 #include "posefair/core/fairing.hpp"
 
+#include <limits>
 #include <random>
 #include <stdexcept>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "posefair/core/difference_operators.hpp"
+#include "posefair/core/fairing_sweep.hpp"
 #include "posefair/core/synthetic_motion.hpp"
 
 namespace posefair {
@@ -167,6 +170,138 @@ TEST(Fairing, BadParametersAndMismatchedPositionsAreErrors) {
   PoseSequence broken = in.noisy;
   broken.position.pop_back();
   EXPECT_THROW(fair(broken, p), std::invalid_argument);
+}
+
+// fair() before its sweep was fused (fairing_sweep.hpp): the operators on quaternions, one
+// after the other, as the real-time engine still calls them. The reference for the tests below.
+FairingResult operator_loop(const PoseSequence& input, const FairingParams& params) {
+  const std::size_t n = input.size();
+  const bool with_p = input.has_position();
+  std::vector<Quat> q0(input.orientation.begin(), input.orientation.end());
+  for (Quat& q : q0) q.normalize();
+  so3::make_continuous(q0);
+  const std::vector<Vec3>& p0 = input.position;
+  std::vector<Quat> q = q0, q_next(n), target(n);
+  std::vector<Vec3> u(n - 1), p = p0, p_next, p_target(with_p ? n : 0);
+  FairingResult r;
+  for (int k = 0; k < params.max_iterations; ++k) {
+    q_next = q;
+    damped_rotation_sweep(params.order, params.variant, params.lambda_r, q_next, u, target);
+    if (with_p) {
+      p_next = p;
+      damped_position_sweep(params.order, params.lambda_t, p_next, p_target);
+    }
+    bool within = true;
+    double step = 0.0;
+    for (std::size_t i = 0; i < n && within; ++i)
+      within = so3::dist(q0[i], q_next[i]) < params.epsilon_r && (!with_p || (p_next[i] - p0[i]).norm() < params.epsilon_t);
+    if (!within) {
+      r.stop = StopReason::Bound;
+      break;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      step = std::max(step, so3::dist(q[i], q_next[i]));
+      if (with_p) step = std::max(step, (p_next[i] - p[i]).norm());
+    }
+    q.swap(q_next);
+    if (with_p) p.swap(p_next);
+    r.iterations = k + 1;
+    if (step <= params.step_tolerance) {
+      r.stop = StopReason::Converged;
+      break;
+    }
+  }
+  r.poses.orientation.resize(n);
+  for (std::size_t i = 0; i < n; ++i) r.poses.orientation[i] = so3::aligned_to(q[i], input.orientation[i]);
+  r.poses.position = p;
+  return r;
+}
+
+double largest_difference(const std::vector<Quat>& a, const std::vector<Quat>& b) {
+  double d = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, (a[i].coeffs() - b[i].coeffs()).cwiseAbs().maxCoeff());
+  return d;
+}
+
+// One sweep, every order, variant and length (lengths below and above the lane width reach
+// the one-at-a-time remainder and the ends): the fused sweep against the operators.
+TEST(FairingSweep, OneSweepAgreesWithTheOperatorsToRoundingAndPositionsBitForBit) {
+  for (int m : {2, 3}) {
+    for (OperatorVariant v : {OperatorVariant::Corrected, OperatorVariant::Printed}) {
+      for (std::size_t n : {3u, 4u, 5u, 6u, 7u, 8u, 9u, 12u, 13u, 61u}) {
+        if (n < static_cast<std::size_t>(min_samples_for_order(m))) continue;
+        const auto in = motion(n + 10u * static_cast<std::size_t>(m), true, n);
+        FairingParams p;
+        p.order = m;
+        p.variant = v;
+        p.lambda_r = 0.3;
+        std::vector<Quat> q0 = in.noisy.orientation;
+        so3::make_continuous(q0);
+        FairingSweep sweep(p, q0, in.noisy.position);
+        EXPECT_TRUE(sweep.sweep().moved);
+        sweep.accept();
+        std::vector<Quat> q;
+        std::vector<Vec3> pos;
+        sweep.current(q, pos);
+
+        std::vector<Quat> q_ref = q0, target(n);
+        std::vector<Vec3> u(n - 1), p_ref = in.noisy.position, p_target(n);
+        damped_rotation_sweep(m, v, p.lambda_r, q_ref, u, target);
+        damped_position_sweep(m, p.lambda_t, p_ref, p_target);
+        EXPECT_LT(largest_difference(q, q_ref), 1e-15) << "m " << m << " n " << n;
+        for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(pos[i], p_ref[i]) << "m " << m << " n " << n << " i " << i;
+      }
+    }
+  }
+}
+
+// The whole loop: 100 sweeps, or until the bound or the tolerance stops it, on several inputs.
+TEST(FairingSweep, FairAgreesWithTheOperatorLoopTo1e12) {
+  struct Case {
+    int order;
+    OperatorVariant variant;
+    bool with_position;
+    std::size_t n;
+    double eps_r, eps_t, tolerance;
+    int iterations;
+  };
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const Case cases[] = {
+      {3, OperatorVariant::Corrected, true, 300, kInf, kInf, 0.0, 100},   // the paper's timing case
+      {3, OperatorVariant::Printed, false, 57, kInf, kInf, 0.0, 100},
+      {2, OperatorVariant::Corrected, true, 100, 0.03, 5.0, 0.0, 1000},   // stops at the bound
+      {2, OperatorVariant::Printed, false, 33, kInf, kInf, 0.0, 100},
+      {3, OperatorVariant::Corrected, false, 100, 0.05, kInf, 0.0, 1000},  // stops at the bound
+      {2, OperatorVariant::Corrected, false, 10, kInf, kInf, 1e-9, 100000},  // converges
+  };
+  for (const Case& c : cases) {
+    const auto in = motion(c.n, c.with_position, c.n);
+    FairingParams p;
+    p.order = c.order;
+    p.variant = c.variant;
+    p.epsilon_r = c.eps_r;
+    p.epsilon_t = c.eps_t;
+    p.step_tolerance = c.tolerance;
+    p.max_iterations = c.iterations;
+    if (c.tolerance > 0.0) p.lambda_r = 0.5;
+    const auto fused = fair(in.noisy, p);
+    const auto ref = operator_loop(in.noisy, p);
+    EXPECT_EQ(fused.stop, ref.stop) << c.n;
+    EXPECT_EQ(fused.iterations, ref.iterations) << c.n;
+    EXPECT_LT(largest_difference(fused.poses.orientation, ref.poses.orientation), 1e-12) << c.n;
+    EXPECT_EQ(fused.poses.position, ref.poses.position) << c.n;
+  }
+  // Nothing moves at all: with no tolerance, the loop stops as soon as a sweep changes nothing.
+  PoseSequence still;
+  for (int i = 0; i < 20; ++i) {
+    still.time.push_back(0.01 * i);
+    still.orientation.push_back(Quat(0.5, 0.5, 0.5, 0.5));
+  }
+  FairingParams p;
+  const auto fused = fair(still, p), ref = operator_loop(still, p);
+  EXPECT_EQ(fused.stop, StopReason::Converged);
+  EXPECT_EQ(ref.stop, StopReason::Converged);
+  EXPECT_LT(largest_difference(fused.poses.orientation, ref.poses.orientation), 1e-15);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include "posefair/core/quaternion_spline.hpp"
 #include "posefair/core/quaternion_spline_example.hpp"
+#include "posefair/core/quaternion_spline_study.hpp"
 
 namespace posefair {
 namespace {
@@ -118,5 +119,37 @@ TEST(QuaternionSplineReproduction, TheZeroComponentStaysZero) {
   for (double t = 0.0; t <= 6.0; t += 0.01) EXPECT_EQ(c.position(t)(3), 0.0);
 }
 
+// Seeded key sets of the example's kind (docs/quaternion-splines.md has 10 of each, against the
+// 54-frame optimum estimate): "within 0.1 % with 4 variable frames" holds for keys 10°-20° apart
+// on S³ and not for keys 30°-50° apart like the example's; the norm's time-average deviation is
+// about a third of its maximum, not the paper's tenth, with either. To stay fast under the
+// sanitizers the gap is taken to the 24-frame optimum, which lies within 0.005 % of the estimate
+// on every set there: the true gap is at least this one, and at most 0.005 % more.
+TEST(QuaternionSplineReproduction, FourFramesWithinATenthOfAPercentDependsOnTheKeySteps) {
+  auto run = [](const SplineKeyframes& keys, int frames) {
+    QuaternionSplineOptions o;
+    o.variable_frames = frames;
+    o.frames_per_round = frames == 24 ? 24 : 1;
+    return build_quaternion_spline(keys, o);
+  };
+  for (const bool large : {true, false}) {
+    const SplineKeyframes keys = large ? random_seven_keyframes(1, 30.0, 50.0) : random_seven_keyframes(1, 10.0, 20.0);
+    const QuaternionSplineResult four = run(keys, 4);
+    const double best = run(keys, 24).stages.back().objective;
+    const double gap = (four.stages.back().objective - best) / best;
+    EXPECT_GT(gap, 0.0);
+    if (large) {
+      EXPECT_GT(gap, 1e-3);
+      EXPECT_LT(gap, 1e-2);
+    } else {
+      EXPECT_LT(gap, 1e-3 - 5e-5);
+    }
+    const double max_dev = max_norm_deviation(four.spline.curve);
+    EXPECT_LT(max_dev, 0.01);
+    const double ratio = mean_norm_deviation(four.spline.curve) / max_dev;
+    EXPECT_GT(ratio, 0.2) << large;
+    EXPECT_LT(ratio, 0.5) << large;
+  }
+}
 }  // namespace
 }  // namespace posefair

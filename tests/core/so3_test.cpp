@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "posefair/core/quaternion_lanes.hpp"
 #include "test_sequences.hpp"
 
 namespace posefair {
@@ -125,6 +126,48 @@ TEST(So3, MakeContinuousRemovesHemisphereFlipsWhateverTheInputSigns) {
       EXPECT_GE(base[i].dot(base[i - 1]), 0.0) << i;
     }
   }
+}
+
+// The batch sweep's branch-free exp and log (quaternion_lanes.hpp) against so3's, one at a time
+// and kLaneWidth at a time, over the whole range of half-angles, both hemispheres.
+TEST(So3, LaneExpAndLogAgreeWithSo3ToRounding) {
+  using lanes::kLaneWidth;
+  using lanes::Lane;
+  std::mt19937_64 rng(17);
+  std::vector<Vec3> v;
+  for (double a : kAngles)
+    for (int k = 0; k < 3; ++k) v.push_back(a * random_direction(rng));
+  while (v.size() % kLaneWidth) v.push_back(Vec3::Zero());
+  double worst_exp = 0.0, worst_log = 0.0;
+  auto check = [&](std::size_t i, const lanes::QuatOf<double>& e, const lanes::VecOf<double>& l, const Quat& q) {
+    const Quat ref = so3::exp(v[i]);
+    worst_exp = std::max(worst_exp, (Quat(e.w, e.x, e.y, e.z).coeffs() - ref.coeffs()).cwiseAbs().maxCoeff());
+    const Vec3 lr = so3::log(q);
+    worst_log = std::max(worst_log, (Vec3(l.x, l.y, l.z) - lr).norm() / std::max(lr.norm(), 1e-300));
+  };
+  for (std::size_t i = 0; i < v.size(); i += kLaneWidth) {
+    double vx[kLaneWidth], vy[kLaneWidth], vz[kLaneWidth], qw[kLaneWidth], qx[kLaneWidth], qy[kLaneWidth], qz[kLaneWidth];
+    std::vector<Quat> q;
+    for (int k = 0; k < kLaneWidth; ++k) {
+      vx[k] = v[i + k].x(), vy[k] = v[i + k].y(), vz[k] = v[i + k].z();
+      q.push_back(so3::exp(v[i + k]));
+      if ((i + k) % 2) q.back().coeffs() = -q.back().coeffs();  // log must choose w >= 0
+      qw[k] = q.back().w(), qx[k] = q.back().x(), qy[k] = q.back().y(), qz[k] = q.back().z();
+    }
+    const auto e = lanes::exp(lanes::VecOf<Lane>{lanes::load<Lane>(vx), lanes::load<Lane>(vy), lanes::load<Lane>(vz)});
+    const auto l = lanes::log(lanes::QuatOf<Lane>{lanes::load<Lane>(qw), lanes::load<Lane>(qx), lanes::load<Lane>(qy),
+                                                  lanes::load<Lane>(qz)});
+    double ew[kLaneWidth], ex[kLaneWidth], ey[kLaneWidth], ez[kLaneWidth], lx[kLaneWidth], ly[kLaneWidth], lz[kLaneWidth];
+    lanes::store(ew, e.w), lanes::store(ex, e.x), lanes::store(ey, e.y), lanes::store(ez, e.z);
+    lanes::store(lx, l.x), lanes::store(ly, l.y), lanes::store(lz, l.z);
+    for (int k = 0; k < kLaneWidth; ++k) {
+      check(i + k, {ew[k], ex[k], ey[k], ez[k]}, {lx[k], ly[k], lz[k]}, q[k]);
+      check(i + k, lanes::exp(lanes::VecOf<double>{vx[k], vy[k], vz[k]}),
+            lanes::log(lanes::QuatOf<double>{qw[k], qx[k], qy[k], qz[k]}), q[k]);  // one at a time
+    }
+  }
+  EXPECT_LT(worst_exp, 1e-15);
+  EXPECT_LT(worst_log, 2e-15);
 }
 
 }  // namespace

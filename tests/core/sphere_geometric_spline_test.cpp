@@ -11,6 +11,7 @@
 
 #include "geometric_spline_test_support.hpp"
 #include "posefair/core/sphere_geometric_spline.hpp"
+#include "posefair/core/sphere_spline_figure6.hpp"
 
 namespace posefair::geometric_splines {
 namespace {
@@ -23,12 +24,9 @@ double fd_tolerance(int j) { return j <= 2 ? 1e-7 : 1e-7 * std::pow(100.0, j - 2
 
 using P3 = SpherePoint<3>;
 
-const double kSqrt3 = std::sqrt(3.0);
-const P3 kFig6P0(kSqrt3 / 2, -kSqrt3 / 4, 0.25);
-const P3 kFig6P1(0.5, kSqrt3 / 4, -0.75);
-const P3 kFig6V0(0.5, kSqrt3, 3 - kSqrt3);
-const P3 kFig6V1Printed(0.1, 1.8, (9 * kSqrt3 - 1) / 15);
-const P3 kFig6V1Corrected(-0.1, 1.8, (9 * kSqrt3 - 1) / 15);
+const Figure6Data kFig6 = figure6_data();
+const P3 kFig6P0 = kFig6.p0, kFig6P1 = kFig6.p1, kFig6V0 = kFig6.v0;
+const P3 kFig6V1Printed = kFig6.v1_printed, kFig6V1Corrected = kFig6.v1_corrected;
 
 template <int D>
 SpherePoint<D> tangential(const SpherePoint<D>& p, const SpherePoint<D>& x) {

@@ -145,9 +145,10 @@ TEST(CameraCommand, UsageAndFileErrors) {
 
 TEST(CameraCommand, StudyWritesTheCsvFiles) {
   ScratchDir dir;
-  const auto r = run_posefair("camera --study '" + (dir / "study").string() + "' --study-matrices 5 --study-pairs 5", dir);
+  const auto r = run_posefair("camera --study '" + (dir / "study").string() + "' --study-matrices 5 --study-pairs 5 --study-batches 1", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("section 5.1"));
+  EXPECT_THAT(r.out, HasSubstr("1 batches of 1000"));
   for (const char* f : {"sqrt_iterations.csv", "log_square_roots.csv", "path_length.csv"})
     EXPECT_GT(testing::slurp(dir / "study" / f).size(), 50u) << f;
 }

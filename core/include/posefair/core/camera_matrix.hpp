@@ -71,5 +71,8 @@ Result<std::vector<Mat4>> interpolate_cameras(InterpolationMethod method, std::s
 // (each along its shorter way round), field of view, aspect, skew, centre of projection and
 // near/far, each linearly.
 Mat4 camera_parameter_lerp_matrix(const CameraParams& a, const CameraParams& b, double t);
+// The same without P_a: P_b S R T of the interpolated parameters, the affine map into camera
+// space that matrix interpolation's M(t) corresponds to (Section 5.1 measures there).
+Mat4 camera_parameter_lerp_affine(const CameraParams& a, const CameraParams& b, double t);
 
 }  // namespace posefair

@@ -10,10 +10,14 @@
 
 namespace posefair {
 
+// How Section 4.2's scales in [1e-2, 1e2] are drawn (the paper gives only the range).
+enum class ScaleDraw { LogUniform, Uniform };
+
 // Section 4.2's random transform T R S: R = Rz Ry Rx with each angle uniform in
-// [min_angle, max_angle], scales log-uniform in [1e-2, 1e2] per axis, translations uniform in
-// [0.1, 100] per axis.
-Mat4 random_test_transform(std::mt19937_64& rng, double min_angle = 0.0, double max_angle = 3.141592653589793);
+// [min_angle, max_angle], scales in [1e-2, 1e2] per axis (log-uniform unless asked otherwise),
+// translations uniform in [0.1, 100] per axis.
+Mat4 random_test_transform(std::mt19937_64& rng, double min_angle = 0.0, double max_angle = 3.141592653589793,
+                           ScaleDraw scales = ScaleDraw::LogUniform);
 
 // 4.2.1: |XX - A| before each Denman-Beavers update (no stopping; up to `iterations` updates).
 struct SqrtStudyRow {
@@ -47,25 +51,39 @@ struct LargeRotationStudy {
   int log_root_cap = 0;                  // matrix_log: 20 roots did not reach eps1 (or a root failed)
   double worst_log_error = 0.0;          // relative, against Eigen, over the successes
 };
-LargeRotationStudy large_rotation_study(int matrices, std::uint64_t seed);
+LargeRotationStudy large_rotation_study(int matrices, std::uint64_t seed, ScaleDraw scales = ScaleDraw::LogUniform);
 
 // 5.1: random keyframe pairs of cameras around a sphere mesh; per pair the mean excess length
-// 100 (l - l0) / l0 (ERRATA item 3) of the vertices' screen paths (x, y after the divide) at
-// t = 0, 0.1, .., 1. Vertices whose screen displacement l0 is under 0.01 or which pass behind
-// the camera are left out (and counted).
+// 100 (l - l0) / l0 (ERRATA item 3) of the vertices' paths at t = 0, 0.1, .., 1, measured twice:
+//   in camera space (the paper's Fig. 8): the vertex under the affine camera map P_b S R T
+//     (matrix interpolation's M(t); for parameter interpolation the interpolated parameters'),
+//     before P_a and the divide;
+//   on the screen: x, y after the divide (a second view).
+// Vertices whose displacement l0 is under 1e-3 of the mesh's radius (camera space) or under
+// 0.01 (screen), or which pass behind the camera (screen), are left out and counted.
+enum class KeyPairDraw {
+  UniformAngle,  // key b is key a's view turned by an angle uniform in [0°, 90°) about a random
+                 // axis, at its own distance (3-6) and with its own lens
+  Independent,   // both keys drawn independently (views 60-90° apart, most of them)
+};
 struct PathPairRow {
   int pair;
-  double rotation_deg;      // rotation between the two keys
-  double excess_parameter;  // camera-parameter interpolation, percent
-  double excess_matrix;     // matrix interpolation (eq. 7), percent
-  int vertices_used;
+  double drawn_angle_deg;  // the turn drawn (UniformAngle), else nan
+  double rotation_deg;     // rotation between the two keys' S R T (polar factor)
+  double camera_parameter, camera_matrix;  // mean excess in camera space, percent
+  double screen_parameter, screen_matrix;  // mean excess on the screen, percent
+  int camera_vertices, screen_vertices;    // vertex paths used
+};
+struct PathMeans {
+  double mean_parameter = 0, mean_matrix = 0, median_parameter = 0, median_matrix = 0;
+  int matrix_lower = 0;  // pairs where matrix interpolation's excess is the lower one
 };
 struct PathStudy {
   std::vector<PathPairRow> pairs;
-  int rejected_unsafe = 0;     // generated pairs rotating pi/2 or more (matrix lerp refuses them)
-  int vertices_skipped = 0;
-  double mean_parameter = 0, mean_matrix = 0, median_parameter = 0, median_matrix = 0;
+  int rejected_unsafe = 0;  // generated pairs rotating pi/2 or more (matrix lerp refuses them)
+  int camera_skipped = 0, screen_skipped = 0;
+  PathMeans camera, screen;
 };
-PathStudy path_length_study(int pairs, std::uint64_t seed);
+PathStudy path_length_study(int pairs, std::uint64_t seed, KeyPairDraw draw = KeyPairDraw::UniformAngle);
 
 }  // namespace posefair
