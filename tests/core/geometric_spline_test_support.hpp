@@ -8,6 +8,12 @@
 
 namespace posefair::testing {
 
+// Finite-difference step as a fraction of a segment's length (derivatives in t scale as 1/h^j).
+inline constexpr double kStep = 1e-2;
+// Relative tolerance for a j-th derivative by finite differences: rounding noise grows as
+// 1/step^j, so each order above the second gets two digits less.
+inline double fd_tolerance(int j) { return j <= 2 ? 1e-7 : 1e-7 * std::pow(100.0, j - 2); }
+
 // Weights w_j (j = -J..J) with f^(m)(x) ~ sum_j w_j f(x + j delta) / delta^m: the m-th derivative
 // at 0 of the degree-2J interpolant through the 2J+1 nodes (error O(delta^(2J+1-m))).
 inline Eigen::VectorXd finite_difference_weights(int m, int half_width = 6) {

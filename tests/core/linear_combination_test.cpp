@@ -8,22 +8,15 @@
 
 #include "posefair/core/eigen_matrix_functions.hpp"
 #include "posefair/core/linear_combination.hpp"
+#include "../support/affine_matrices.hpp"
 
 namespace posefair {
 namespace {
 
 using ::testing::HasSubstr;
-
-Mat4 affine(const Eigen::Matrix3d& l, const Eigen::Vector3d& t) {
-  Mat4 m = Mat4::Identity();
-  m.topLeftCorner<3, 3>() = l;
-  m.topRightCorner<3, 1>() = t;
-  return m;
-}
-Eigen::Matrix3d rot(double angle, const Eigen::Vector3d& axis) {
-  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
-}
-double rel(const Mat4& x, const Mat4& ref) { return norm_inf(x - ref) / norm_inf(ref); }
+using testing::affine;
+using testing::rel;
+using testing::rot;
 const CombinationOptions kP = CombinationOptions::precise();  // the paper's constants: ~1e-4 only
 
 const Mat4 kA = affine(rot(0.7, {1, 2, 0}) * Eigen::Vector3d(1.5, 0.8, 1.1).asDiagonal(), {2, -1, 4});

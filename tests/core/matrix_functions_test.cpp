@@ -12,24 +12,15 @@
 #include "posefair/core/eigen_matrix_functions.hpp"
 #include "posefair/core/matrix_functions.hpp"
 #include "posefair/core/matrix_interpolation_study.hpp"
+#include "../support/affine_matrices.hpp"
 
 namespace posefair {
 namespace {
 
 using ::testing::HasSubstr;
-
-double rel(const Mat4& x, const Mat4& ref) { return norm_inf(x - ref) / norm_inf(ref); }
-
-Mat4 affine(const Eigen::Matrix3d& l, const Eigen::Vector3d& t) {
-  Mat4 m = Mat4::Identity();
-  m.topLeftCorner<3, 3>() = l;
-  m.topRightCorner<3, 1>() = t;
-  return m;
-}
-
-Eigen::Matrix3d rot(double angle, const Eigen::Vector3d& axis) {
-  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
-}
+using testing::affine;
+using testing::rel;
+using testing::rot;
 
 TEST(MatrixExp, MatchesEigenOverManyScales) {
   std::mt19937_64 rng(1);

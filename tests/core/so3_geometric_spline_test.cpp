@@ -15,11 +15,8 @@
 namespace posefair::geometric_splines {
 namespace {
 
-// Finite-difference step as a fraction of a segment's length (derivatives in t scale as 1/h^j).
-constexpr double kStep = 1e-2;
-// Relative tolerance for a j-th derivative by finite differences: rounding noise grows as
-// 1/step^j, so each order above the second gets two digits less.
-double fd_tolerance(int j) { return j <= 2 ? 1e-7 : 1e-7 * std::pow(100.0, j - 2); }
+using testing::fd_tolerance;
+using testing::kStep;
 
 Eigen::Matrix3d hat(const Vec3& w) {
   Eigen::Matrix3d k;

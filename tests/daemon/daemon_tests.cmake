@@ -20,8 +20,7 @@ posefair_add_test(daemon_e2e_tests
   LABELS "daemon;network;e2e;threads")
 add_dependencies(daemon_e2e_tests posefaird posefair)
 
-# status_report_tests: the counter lines and STATUS= text, with and without a device link.
-posefair_add_test(status_report_tests
-  SOURCES status_report_tests.cpp
-  LIBS posefair::service
-  LABELS daemon)
+# status_report_tests.cpp: the counter lines and STATUS= text, with and without a device link;
+# in config_tests (CMakeLists.txt here), which has the same label.
+target_sources(config_tests PRIVATE status_report_tests.cpp)
+target_link_libraries(config_tests PRIVATE posefair::service)

@@ -16,7 +16,7 @@ namespace {
 using testing::angle_about;
 using testing::random_unit_quaternion;
 
-std::vector<Quat> noisy_rotation_stream(std::uint64_t seed, int n, double dt) {
+std::vector<Quat> slerp_input_stream(std::uint64_t seed, int n, double dt) {
   return testing::noisy_rotation_stream(
       seed, n, dt, {Vec3(2.0, 1.5, 2.8), Vec3(1.1, 0.7, 0.3), /*phase=*/0.5, /*noise=*/0.05});
 }
@@ -65,7 +65,7 @@ TEST(ExponentialSlerp, TimeConstantEquivalentToFixedAlphaAtConstantRate) {
   for (double rate : {100.0, 200.0, 60.0}) {
     const double dt = 1.0 / rate, tau = 0.05;
     const double alpha = 1.0 / (1.0 + tau / dt);
-    const std::vector<Quat> qs = noisy_rotation_stream(73, 1000, dt);
+    const std::vector<Quat> qs = slerp_input_stream(73, 1000, dt);
     auto timed = ExponentialSlerpFilter::with_time_constant(tau);
     auto fixed = ExponentialSlerpFilter::with_alpha(alpha);
     auto other = ExponentialSlerpFilter::with_alpha(0.5 * alpha);
@@ -98,7 +98,7 @@ TEST(ExponentialSlerp, FirstSamplePassesThroughNormalisedAndAlphaOneIsPassThroug
 
 TEST(ExponentialSlerp, UnitNormContinuityAndHemisphereInvariance) {
   const double dt = 0.01;
-  const std::vector<Quat> qs = noisy_rotation_stream(83, 4000, dt);
+  const std::vector<Quat> qs = slerp_input_stream(83, 4000, dt);
   std::mt19937_64 rng(89);
   std::bernoulli_distribution flip(0.5);
   std::uniform_real_distribution<double> scale(0.3, 4.0);
@@ -130,7 +130,7 @@ TEST(ExponentialSlerp, ConstantInputIsAFixedPoint) {
 
 TEST(ExponentialSlerp, RepeatedOrOlderTimestampReturnsPreviousOutputAndKeepsState) {
   const double dt = 0.01;
-  const std::vector<Quat> qs = noisy_rotation_stream(101, 500, dt);
+  const std::vector<Quat> qs = slerp_input_stream(101, 500, dt);
   std::mt19937_64 rng(103);
   for (bool timed : {false, true}) {
     auto make = [&] {
@@ -153,7 +153,7 @@ TEST(ExponentialSlerp, RepeatedOrOlderTimestampReturnsPreviousOutputAndKeepsStat
 
 TEST(ExponentialSlerp, ResetForgetsHistory) {
   const double dt = 0.01;
-  const std::vector<Quat> qs = noisy_rotation_stream(107, 300, dt);
+  const std::vector<Quat> qs = slerp_input_stream(107, 300, dt);
   auto used = ExponentialSlerpFilter::with_time_constant(0.05);
   for (std::size_t k = 0; k < 100; ++k) used.filter(qs[299 - k], 50.0 + k * dt);
   used.reset();

@@ -33,7 +33,7 @@ ReadOptions joint(const std::string& name) {
   return o;
 }
 
-PoseFileError error_of(const std::string& text, const ReadOptions& options) {
+PoseFileError bvh_error_of(const std::string& text, const ReadOptions& options) {
   return parse_error(text, "walk.bvh", options);
 }
 
@@ -267,46 +267,46 @@ TEST(BvhFormat, ChangedRotationsAndPositionsAreWrittenExactly) {
 TEST(BvhFormat, ReportsBadInputWithFileAndLine) {
   const std::string small = slurp(kSmall);
   // Unknown joint: the message lists the joints.
-  const PoseFileError unknown = error_of(small, joint("Head"));
+  const PoseFileError unknown = bvh_error_of(small, joint("Head"));
   EXPECT_EQ(unknown.line(), 0u);
   EXPECT_EQ(unknown.message(), "no joint 'Head' in the hierarchy; joints: Hips, Spine, Leg");
-  EXPECT_THAT(error_of(small, joint("")).what(),
+  EXPECT_THAT(bvh_error_of(small, joint("")).what(),
               HasSubstr("walk.bvh:0: BVH needs a joint to read (ReadOptions::bvh_joint); joints: Hips, Spine, Leg"));
 
   // Wrong number of values in a motion row (line 29 is the second frame).
   std::string short_row = small;
   short_row.replace(short_row.find(" -29.0\n"), 6, "");
-  const PoseFileError count = error_of(short_row, joint("Hips"));
+  const PoseFileError count = bvh_error_of(short_row, joint("Hips"));
   EXPECT_EQ(count.line(), 29u);
   EXPECT_EQ(count.message(), "expected 12 values per frame (the HIERARCHY's channels), found 11");
 
   std::string word = small;
   word.replace(word.find(" 13.25 "), 7, " 13.2x5 ");
-  EXPECT_EQ(std::string(error_of(word, joint("Leg")).what()), "walk.bvh:29: field 9 '13.2x5' is not a number");
+  EXPECT_EQ(std::string(bvh_error_of(word, joint("Leg")).what()), "walk.bvh:29: field 9 '13.2x5' is not a number");
 
   std::string inf = small;
   inf.replace(inf.find(" 14.25 "), 7, " inf ");
-  EXPECT_EQ(std::string(error_of(inf, joint("Leg")).what()), "walk.bvh:30: field 9 'inf' is not finite");
+  EXPECT_EQ(std::string(bvh_error_of(inf, joint("Leg")).what()), "walk.bvh:30: field 9 'inf' is not finite");
 
   std::string channel = small;
   channel.replace(channel.find("Xrotation Yrotation Zrotation"), 9, "Wrotation");
-  EXPECT_THAT(error_of(channel, joint("Hips")).what(), HasSubstr("walk.bvh:18: unknown channel 'Wrotation'"));
+  EXPECT_THAT(bvh_error_of(channel, joint("Hips")).what(), HasSubstr("walk.bvh:18: unknown channel 'Wrotation'"));
 
   std::string no_motion = small.substr(0, small.find("MOTION"));
-  EXPECT_THAT(error_of(no_motion, joint("Hips")).what(), HasSubstr("no MOTION section"));
+  EXPECT_THAT(bvh_error_of(no_motion, joint("Hips")).what(), HasSubstr("no MOTION section"));
 
   std::string unbalanced = small;
   unbalanced.erase(unbalanced.rfind('}'), 1);
-  EXPECT_THAT(error_of(unbalanced, joint("Hips")).what(), HasSubstr("walk.bvh:25: unexpected end of HIERARCHY"));
+  EXPECT_THAT(bvh_error_of(unbalanced, joint("Hips")).what(), HasSubstr("walk.bvh:25: unexpected end of HIERARCHY"));
 
   std::string no_rows = small.substr(0, small.find("1.0 2.0 3.0"));
-  EXPECT_EQ(std::string(error_of(no_rows, joint("Hips")).what()), "walk.bvh:0: no samples (no frame rows after MOTION)");
+  EXPECT_EQ(std::string(bvh_error_of(no_rows, joint("Hips")).what()), "walk.bvh:0: no samples (no frame rows after MOTION)");
 
   std::string bad_dt = small;
   bad_dt.replace(bad_dt.find("0.04"), 4, "0");
-  EXPECT_EQ(std::string(error_of(bad_dt, joint("Hips")).what()), "walk.bvh:27: frame time '0' is not positive");
+  EXPECT_EQ(std::string(bvh_error_of(bad_dt, joint("Hips")).what()), "walk.bvh:27: frame time '0' is not positive");
 
-  EXPECT_EQ(std::string(error_of("", joint("Hips")).what()), "walk.bvh:0: empty file");
+  EXPECT_EQ(std::string(bvh_error_of("", joint("Hips")).what()), "walk.bvh:0: empty file");
 
   // A joint without three rotation channels cannot be the sequence.
   std::string two = small;
@@ -314,7 +314,7 @@ TEST(BvhFormat, ReportsBadInputWithFileAndLine) {
   two.replace(two.find(" 0 12.25"), 8, " 12.25");
   two.replace(two.find(" 90 13.25"), 9, " 13.25");
   two.replace(two.find(" 1.0 14.25"), 10, " 14.25");
-  EXPECT_EQ(std::string(error_of(two, joint("Spine")).what()),
+  EXPECT_EQ(std::string(bvh_error_of(two, joint("Spine")).what()),
             "walk.bvh:6: joint 'Spine' has 2 rotation channel(s); it needs three, one per axis");
   EXPECT_EQ(parse_pose_text(two, "two.bvh", joint("Leg")).poses().size(), 3u);  // others still work
 }

@@ -20,11 +20,10 @@ using ::testing::Not;
 
 // An excerpt of BROAD trial 07: 10 rows the optical tracker lost, then 100 kept (tests/data/broad/README.md).
 const std::string kBroad = POSEFAIR_SOURCE_DIR "/tests/data/broad/07_undisturbed_fast_rotation_B.csv";
-const std::string kData = POSEFAIR_SOURCE_DIR "/tests/formats/data/";
 
 ReadOptions csv() { return read_as(PoseFormat::Csv); }
 
-PoseFileError error_of(const std::string& text, const ReadOptions& options = csv()) {
+PoseFileError csv_error_of(const std::string& text, const ReadOptions& options = csv()) {
   return parse_error(text, "walk.csv", options);
 }
 
@@ -76,7 +75,7 @@ TEST(CsvFormat, PrefixedColumnsWithUnitsAndPrefixChoice) {
   EXPECT_EQ(f.poses().position[0], Vec3(1, 2, 3));  // not the gyroscope columns
 
   const std::string two = "time,gt_qw,gt_qx,gt_qy,gt_qz,est_qx,est_qy,est_qz,est_qw\n0,1,0,0,0,0,0,1,0\n";
-  EXPECT_THAT(error_of(two).what(),
+  EXPECT_THAT(csv_error_of(two).what(),
               HasSubstr("walk.csv:1: several quaternion column sets ('est_q*', 'gt_q*')"));
   ReadOptions est = csv();
   est.csv_prefix = "est_";
@@ -91,9 +90,9 @@ TEST(CsvFormat, SkipMissingDropsRowsAndWritesOnlyTheKeptOnes) {
       "1,nan,nan,nan,nan,lost\n"
       "2,,0,0,0,empty\n"
       "3,1,0,0,0,last\n";
-  EXPECT_EQ(error_of(text).message(),
+  EXPECT_EQ(csv_error_of(text).message(),
             "field 2 (qw) 'nan': quaternion is missing (ReadOptions::skip_missing drops such rows)");
-  EXPECT_EQ(error_of(text).line(), 3u);
+  EXPECT_EQ(csv_error_of(text).line(), 3u);
 
   ReadOptions skip = csv();
   skip.skip_missing = true;
@@ -105,10 +104,10 @@ TEST(CsvFormat, SkipMissingDropsRowsAndWritesOnlyTheKeptOnes) {
   EXPECT_EQ(written, "t,qw,qx,qy,qz,note\n0,1,0,0,0,first\n3,1,0,0,0,last\n");
 
   // A nan position is still an error with skip_missing.
-  EXPECT_THAT(error_of("t,qw,qx,qy,qz,x,y,z\n0,1,0,0,0,nan,0,0\n", skip).what(),
+  EXPECT_THAT(csv_error_of("t,qw,qx,qy,qz,x,y,z\n0,1,0,0,0,nan,0,0\n", skip).what(),
               HasSubstr("walk.csv:2: field 6 (x) 'nan' is not finite"));
   // Nothing left at all.
-  EXPECT_THAT(error_of("t,qw,qx,qy,qz\n0,nan,0,0,0\n", skip).what(), HasSubstr("walk.csv:0: no samples"));
+  EXPECT_THAT(csv_error_of("t,qw,qx,qy,qz\n0,nan,0,0,0\n", skip).what(), HasSubstr("walk.csv:0: no samples"));
 }
 
 TEST(CsvFormat, KeepsByteOrderMarkAndCrLfLineEnds) {
@@ -213,7 +212,7 @@ TEST(CsvFormat, ReportsEveryBadInputWithFileAndLine) {
       {"t,qw,qx,qy,qz\n\n", 0, "no samples"},
   };
   for (const Case& c : cases) {
-    const PoseFileError e = error_of(c.text);
+    const PoseFileError e = csv_error_of(c.text);
     EXPECT_EQ(e.line(), c.line) << c.text;
     EXPECT_EQ(e.message(), c.message) << c.text;
     EXPECT_EQ(std::string(e.what()), "walk.csv:" + std::to_string(c.line) + ": " + c.message);
@@ -221,17 +220,17 @@ TEST(CsvFormat, ReportsEveryBadInputWithFileAndLine) {
 }
 
 TEST(CsvFormat, MissingColumnsListWhatIsRequired) {
-  const PoseFileError no_time = error_of("a,qw,qx,qy,qz\n0,1,0,0,0\n");
+  const PoseFileError no_time = csv_error_of("a,qw,qx,qy,qz\n0,1,0,0,0\n");
   EXPECT_EQ(no_time.line(), 1u);
   EXPECT_THAT(no_time.message(), HasSubstr("missing time column; required: a time column (t, time, timestamp or t_s)"));
   EXPECT_THAT(no_time.message(), HasSubstr("header: a, qw, qx, qy, qz"));
 
-  const PoseFileError no_qz = error_of("\n\ntime,qw,qx,qy\n0,1,0,0\n");
+  const PoseFileError no_qz = csv_error_of("\n\ntime,qw,qx,qy\n0,1,0,0\n");
   EXPECT_EQ(no_qz.line(), 3u);
   EXPECT_THAT(no_qz.message(), HasSubstr("missing quaternion column qz;"));
   EXPECT_THAT(no_qz.message(), HasSubstr("quaternion columns qw, qx, qy, qz"));
 
-  const PoseFileError none = error_of("time,value\n0,1\n");
+  const PoseFileError none = csv_error_of("time,value\n0,1\n");
   EXPECT_THAT(none.message(), HasSubstr("missing quaternion columns qw, qx, qy, qz;"));
   // An incomplete second set (gt_qw alone) is just another column.
   EXPECT_EQ(parse_pose_text("t,qw,qx,qy,qz,gt_qw\n0,1,0,0,0,7\n", "x.csv", {}).poses().size(), 1u);

@@ -22,9 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-const std::string kData = POSEFAIR_SOURCE_DIR "/tests/formats/data/";
-
-void spit(const fs::path& p, const std::string& text) {
+void spit_text(const fs::path& p, const std::string& text) {
   std::ofstream out(p, std::ios::binary);
   out << text;
 }
@@ -135,7 +133,7 @@ TEST(AtomicWrite, MissingDirectoryThrowsAndLeavesNothing) {
 TEST(AtomicWrite, ReplacesAnExistingFileOnlyOnSuccess) {
   TempDir dir;
   const fs::path out = dir.path() / "walk.txt";
-  spit(out, "old contents\n");
+  spit_text(out, "old contents\n");
   ::chmod(out.c_str(), 0640);
   const PoseFile f = read_pose_file(kData + "small.tum", {});
 
@@ -159,7 +157,7 @@ TEST(AtomicWrite, FailureAfterTheTemporaryFileExistsRemovesIt) {
   // The target is a directory: the temporary file is created, then the write is refused.
   const fs::path target = dir.path() / "taken";
   fs::create_directory(target);
-  spit(target / "inside", "x");
+  spit_text(target / "inside", "x");
   EXPECT_THAT([&] { write_file_atomically(target, "new\n"); },
               ::testing::ThrowsMessage<PoseFileError>(HasSubstr("taken:0: not a regular file")));
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"taken"});
@@ -167,7 +165,7 @@ TEST(AtomicWrite, FailureAfterTheTemporaryFileExistsRemovesIt) {
 
   // A stale temporary file of a dead process with our pid does not block the write.
   const fs::path out = dir.path() / "out.csv";
-  spit(out.string() + ".tmp." + std::to_string(::getpid()), "stale");
+  spit_text(out.string() + ".tmp." + std::to_string(::getpid()), "stale");
   write_file_atomically(out, "fresh\n");
   EXPECT_EQ(slurp(out), "fresh\n");
   EXPECT_EQ(dir.entries(), (std::vector<std::string>{"out.csv", "taken"}));

@@ -12,6 +12,9 @@ namespace posefair::formats {
 
 using ::posefair::testing::slurp;
 
+// The small pose files the format tests read (tests/formats/data/).
+inline const std::string kData = POSEFAIR_SOURCE_DIR "/tests/formats/data/";
+
 // A fresh scratch directory for the running test, named after it
 // ("posefair_<Suite>_<Test>_XXXXXX", e.g. posefair_TumFormat_FreshFileRoundTrips_a1B2c3),
 // removed at the end.

@@ -17,11 +17,10 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
 const std::string kRecorded = POSEFAIR_SOURCE_DIR "/tests/data/tum/";  // excerpts, see its README.md
-const std::string kData = POSEFAIR_SOURCE_DIR "/tests/formats/data/";
 
 ReadOptions tum() { return read_as(PoseFormat::Tum); }
 
-PoseFileError error_of(const std::string& text, const ReadOptions& options = tum()) {
+PoseFileError tum_error_of(const std::string& text, const ReadOptions& options = tum()) {
   return parse_error(text, "walk.txt", options);
 }
 
@@ -145,7 +144,7 @@ TEST(TumFormat, ReportsEveryBadInputWithFileAndLine) {
       {"# only a comment\n\n", 0, "no samples"},
   };
   for (const Case& c : cases) {
-    const PoseFileError e = error_of(c.text);
+    const PoseFileError e = tum_error_of(c.text);
     EXPECT_EQ(e.path(), "walk.txt");
     EXPECT_EQ(e.line(), c.line) << c.text;
     EXPECT_EQ(e.message(), c.message) << c.text;
@@ -156,7 +155,7 @@ TEST(TumFormat, ReportsEveryBadInputWithFileAndLine) {
   // A tighter tolerance turns a renormalisable quaternion into an error.
   ReadOptions strict = tum();
   strict.unit_tolerance = 1e-6;
-  EXPECT_THAT(error_of("1 0 0 0 0 0 0 1.001\n", strict).what(),
+  EXPECT_THAT(tum_error_of("1 0 0 0 0 0 0 1.001\n", strict).what(),
               HasSubstr("walk.txt:1: non-unit quaternion: norm 1.001"));
 }
 

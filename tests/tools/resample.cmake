@@ -1,6 +1,3 @@
-# posefair resample end to end (tools/resample_command.cpp). Included from tests/tools/CMakeLists.txt.
-posefair_add_test(resample_cli_tests
-  SOURCES resample_command_test.cpp
-  LIBS posefair::core posefair::formats GTest::gmock
-  LABELS cli)
-add_dependencies(resample_cli_tests posefair)
+# posefair resample end to end (tools/resample_command.cpp), in cli_tests. Included from
+# tests/tools/CMakeLists.txt.
+target_sources(cli_tests PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/resample_command_test.cpp)

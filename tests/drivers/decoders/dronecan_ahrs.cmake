@@ -1,2 +1,2 @@
 # The DroneCAN uavcan.equipment.ahrs.Solution decoder (and float16).
-posefair_add_test(dronecan_ahrs_decoder_tests SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/decoders/dronecan_ahrs_decoder_test.cpp LIBS posefair::drivers LABELS drivers)
+target_sources(drivers_tests PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/decoders/dronecan_ahrs_decoder_test.cpp)
