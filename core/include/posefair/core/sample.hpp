@@ -12,6 +12,13 @@ enum SampleFlags : std::uint32_t {
   kHasDeviceTime = 1u << 1,
   kClamped = 1u << 2,  // FairedPose only: the ε projection moved this pose (it sits on its bound)
   kBridged = 1u << 3,  // made on a spline across a gap in the input (gap_bridge.hpp), not measured
+  // Raw inertial readings (issue 17), in the sensor's own frame, SI units. A sample may carry
+  // them beside a measured orientation (gyro-aided fairing) or alone (kNoOrientation: the
+  // orientation field is not a measurement, and a fusion stage must make one first).
+  kHasGyro = 1u << 4,        // gyro, rad/s
+  kHasAccel = 1u << 5,       // accel, m/s^2 (specific force: +g upwards at rest)
+  kHasMag = 1u << 6,         // mag, microtesla
+  kNoOrientation = 1u << 7,  // raw inertial sample only
 };
 
 struct Sample {
@@ -22,9 +29,16 @@ struct Sample {
   double receive_time = 0.0;    // seconds, CLOCK_MONOTONIC at the read that completed the sample
   Quat orientation = Quat::Identity();
   Vec3 position = Vec3::Zero(); // valid with kHasPosition
+  Vec3 gyro = Vec3::Zero();     // rad/s, valid with kHasGyro
+  Vec3 accel = Vec3::Zero();    // m/s^2, valid with kHasAccel
+  Vec3 mag = Vec3::Zero();      // microtesla, valid with kHasMag
   std::uint32_t flags = 0;
 
   bool has_position() const { return (flags & kHasPosition) != 0; }
+  bool has_orientation() const { return (flags & kNoOrientation) == 0; }
+  bool has_gyro() const { return (flags & kHasGyro) != 0; }
+  bool has_accel() const { return (flags & kHasAccel) != 0; }
+  bool has_mag() const { return (flags & kHasMag) != 0; }
 };
 
 // A faired pose leaving the engine: the sample's own time and identity, the faired values,
