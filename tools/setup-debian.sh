@@ -8,6 +8,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
+  lld                    # links faster than GNU ld (CMakeLists.txt, POSEFAIR_USE_LLD)
   libeigen3-dev          # core math
   googletest libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # benchmarks

@@ -1,5 +1,7 @@
 #include "posefair/core/banded_cholesky.hpp"
 
+#include "posefair/core/combinatorics.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -52,9 +54,7 @@ bool assemble_smoothing_system(BandedCholesky& a, int n, int m, double mu, std::
     // Stencil of D^m: (-1)^(m-k) C(m, k), k = 0..m (m ≤ 3 here; at most 8 entries in any case).
     double c[9] = {};
     for (int k = 0; k <= m && k < 9; ++k) {
-      double binom = 1.0;
-      for (int j = 1; j <= k; ++j) binom = binom * (m - j + 1) / j;
-      c[k] = ((m - k) % 2 == 0 ? 1.0 : -1.0) * binom;
+      c[k] = ((m - k) % 2 == 0 ? 1.0 : -1.0) * binomial(m, k);
     }
     for (int row = 0; row + m < n; ++row)
       for (int k = 0; k <= m; ++k)

@@ -1,21 +1,12 @@
 #include "posefair/core/smoother_rows.hpp"
 
+#include "posefair/core/combinatorics.hpp"
 #include "posefair/core/difference_operators.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace posefair {
-namespace {
-
-double factorial(int m) {
-  double f = 1.0;
-  for (int i = 2; i <= m; ++i) f *= i;
-  return f;
-}
-
-}  // namespace
-
 EmissionRow make_emission_row(int capacity) {
   EmissionRow row;
   row.zeta.assign(static_cast<std::size_t>(std::max(0, capacity - 1)), 0.0);

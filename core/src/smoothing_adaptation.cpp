@@ -1,5 +1,7 @@
 #include "posefair/core/smoothing_adaptation.hpp"
 
+#include "posefair/core/combinatorics.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -7,12 +9,6 @@
 
 namespace posefair {
 namespace {
-
-double binomial(int n, int k) {
-  double b = 1.0;
-  for (int j = 1; j <= k; ++j) b = b * (n - k + j) / j;
-  return b;
-}
 
 // Median of the χ distribution with 3 degrees of freedom: the length of a 3-vector of unit
 // normal components is below this half of the time.
@@ -43,15 +39,14 @@ void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& s
   Eigen::Vector4d unit = Eigen::Vector4d::Zero();
   unit(m) = 1.0;
   const Eigen::Vector4d a = ldlt.solve(unit);  // row m of (XᵀX)⁻¹
-  double factorial = 1.0;
-  for (int p = 2; p <= m; ++p) factorial *= p;
+  const double m_factorial = factorial(m);
   // Σ w_i θ_i = −Σ_j W_j ζ_j with W_j = Σ_{i≤j} w_i (the weights sum to zero).
   double cumulative = 0.0;
   fit_noise_gain_ = 0.0;
   for (int i = 0; i < span_; ++i) {
     double w = 0.0;
     for (int p = 0; p < q; ++p) w += a(p) * std::pow(i - c, p);
-    w *= factorial;
+    w *= m_factorial;
     fit_noise_gain_ += w * w;
     cumulative += w;
     if (i < span_ - 1) fit_[static_cast<std::size_t>(i)] = -cumulative;

@@ -5,11 +5,6 @@
 #include <string>
 
 namespace posefair::geometric_splines {
-double binomial(int n, int r) {
-  double b = 1.0;
-  for (int i = 1; i <= r; ++i) b = b * (n - r + i) / i;
-  return b;
-}
 
 double polynomial_derivative(const double* c, int n, double u, int j) {
   // Horner over the j-times differentiated coefficients c[m] * m! / (m - j)!.

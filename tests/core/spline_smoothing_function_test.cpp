@@ -10,18 +10,6 @@
 namespace posefair::geometric_splines {
 namespace {
 
-double binomial(int n, int r) {
-  double b = 1.0;
-  for (int i = 1; i <= r; ++i) b = b * (n - r + i) / i;
-  return b;
-}
-
-double factorial(int n) {
-  double f = 1.0;
-  for (int i = 2; i <= n; ++i) f *= i;
-  return f;
-}
-
 TEST(SmoothingFunction, ClosedFormsOfRemark34) {
   const SmoothingFunction k1(1), k2(2), k3(3);
   for (double u = -0.5; u <= 1.5; u += 0.0625) {

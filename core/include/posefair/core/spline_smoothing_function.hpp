@@ -9,13 +9,14 @@
 // item 1: the OCR dropped the minus sign); k = 3: u^3 (10 - 15u + 6u^2).
 #include <Eigen/Core>
 
+#include "posefair/core/combinatorics.hpp"
+
 namespace posefair::geometric_splines {
 
 // Highest supported smoothness order k (phi has degree 2k-1, the weights 4k-2).
 inline constexpr int kMaxSplineOrder = 8;
 
-// The binomial coefficient C(n, r) as a double (small n: phi's and Leibniz's coefficients).
-double binomial(int n, int r);
+using posefair::binomial;  // phi's and Leibniz's coefficients (combinatorics.hpp)
 
 class SmoothingFunction {
  public:
