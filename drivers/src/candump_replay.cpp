@@ -22,6 +22,9 @@ class Stamper final : public DecodedSink {
     s.device_time = d.device_time;
     s.orientation = d.orientation;
     s.position = d.position;
+    s.gyro = d.gyro;
+    s.accel = d.accel;
+    s.mag = d.mag;
     s.flags = d.flags;
     const std::optional<double> device = (d.flags & kHasDeviceTime) ? std::optional<double>(d.device_time) : std::nullopt;
     s.time = base_.update(receive_time_, device).time;

@@ -28,8 +28,11 @@ class SampleStamper final : public DecodedSink {
     s.sequence = sequence_++;
     s.receive_time = receive_time_;
     s.orientation = d.orientation;
-    s.flags = d.flags & (kHasPosition | kHasDeviceTime);
+    s.flags = d.flags & (kHasPosition | kHasDeviceTime | kHasGyro | kHasAccel | kHasMag | kNoOrientation);
     if (s.has_position()) s.position = d.position;
+    if (s.has_gyro()) s.gyro = d.gyro;
+    if (s.has_accel()) s.accel = d.accel;
+    if (s.has_mag()) s.mag = d.mag;
     std::optional<double> device;
     if ((s.flags & kHasDeviceTime) != 0) {
       s.device_time = d.device_time;
