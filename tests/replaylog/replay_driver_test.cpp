@@ -132,12 +132,7 @@ TEST(ReplayDriver, RawReadingsOfARecordedDeviceReplayIntact) {
       s.stream_id = 10;
       s.sequence = samples.size();
       s.time = 0.01 * static_cast<double>(samples.size());
-      s.orientation = d.orientation;
-      s.flags = d.flags;
-      s.device_time = d.device_time;
-      s.gyro = d.gyro;
-      s.accel = d.accel;
-      s.mag = d.mag;
+      fill_sample(d, s);
       samples.push_back(s);
     }
   } recorder;

@@ -38,6 +38,19 @@ struct DecodedSample {
   bool has_frame_counter = false;
 };
 
+// What a decoded sample gives a Sample: its flags (the Sample's kinds only: kHasPosition,
+// kHasDeviceTime, the raw readings' and kNoOrientation), orientation, and each value its flags
+// declare. Stream id, sequence and times are the stamper's.
+inline void fill_sample(const DecodedSample& d, Sample& s) {
+  s.flags = d.flags & (kHasPosition | kHasDeviceTime | kHasGyro | kHasAccel | kHasMag | kNoOrientation);
+  s.orientation = d.orientation;
+  if (s.has_position()) s.position = d.position;
+  if ((s.flags & kHasDeviceTime) != 0) s.device_time = d.device_time;
+  if (s.has_gyro()) s.gyro = d.gyro;
+  if (s.has_accel()) s.accel = d.accel;
+  if (s.has_mag()) s.mag = d.mag;
+}
+
 struct DecoderCounters {
   std::uint64_t bytes = 0;           // bytes fed
   std::uint64_t frames = 0;          // whole frames whose checksum (or CRC) matched
