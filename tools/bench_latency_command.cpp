@@ -127,7 +127,7 @@ int bench_latency(const LatencyOptions& o) {
 
     daemon::HistogramSnapshot all;
     std::uint64_t received = 0, emitted = 0, ring_dropped = 0, publish_dropped = 0, rejected = 0, out_of_order = 0,
-                  published = 0, failures = 0, worst_p99 = 0;
+                  raw_unfused = 0, published = 0, failures = 0, worst_p99 = 0;
     for (const daemon::StreamStats& s : pipeline.stats()) {
       merge(all, s.latency);
       received += s.received;
@@ -136,6 +136,7 @@ int bench_latency(const LatencyOptions& o) {
       publish_dropped += s.publish_dropped;
       rejected += s.rejected;
       out_of_order += s.out_of_order;
+      raw_unfused += s.raw_unfused;
       published += s.published;
       failures += s.send_failures;
       worst_p99 = std::max(worst_p99, s.latency.percentile(99));
@@ -146,7 +147,7 @@ int bench_latency(const LatencyOptions& o) {
     std::printf("latency us  p50 %.1f  p90 %.1f  p99 %.1f  p99.9 %.1f  max %.1f  (worst stream p99 %.1f)\n",
                 us(all.percentile(50)), us(all.percentile(90)), us(all.percentile(99)), us(all.percentile(99.9)),
                 us(all.max), us(worst_p99));
-    const std::uint64_t accounted = emitted + ring_dropped + rejected + out_of_order;
+    const std::uint64_t accounted = emitted + ring_dropped + rejected + out_of_order + raw_unfused;
     std::printf("drops       ring %" PRIu64 ", publish %" PRIu64 ", rejected %" PRIu64 ", out-of-order %" PRIu64
                 ", send failures %" PRIu64 "; unaccounted %" PRId64 "\n",
                 ring_dropped, publish_dropped, rejected, out_of_order, failures,

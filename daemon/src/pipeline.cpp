@@ -323,7 +323,15 @@ void Pipeline::engine_loop() {
       for (int budget = kPopBudget; budget > 0 && s.ring.pop(r); --budget) {
         any = true;
         if (hooks_.before_engine_sample) hooks_.before_engine_sample(s.config.id);
-        emitted = fair(s, unpack(r), r.enqueued_ns) || emitted;
+        const Sample sample = unpack(r);
+        // A raw-only sample's quaternion is a placeholder, not a measurement: until a fusion
+        // stage makes an orientation from its readings it must not reach the window (the
+        // recorder has it already). Counted, and the stream goes on.
+        if (!sample.has_orientation()) {
+          s.counters.raw_unfused.fetch_add(1, std::memory_order_relaxed);
+          continue;
+        }
+        emitted = fair(s, sample, r.enqueued_ns) || emitted;
       }
       // Wake the publisher after each stream's batch (not after the whole pass), so it works
       // alongside the engine instead of after it.
@@ -424,6 +432,7 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.ring_dropped = s.ring.dropped();
     st.rejected = get(s.counters.rejected);
     st.out_of_order = get(s.counters.out_of_order);
+    st.raw_unfused = get(s.counters.raw_unfused);
     st.emitted = get(s.counters.emitted);
     st.clamped = get(s.counters.clamped);
     st.restarts = get(s.counters.restarts);

@@ -100,6 +100,10 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
                   us(s.latency.percentile(50)), us(s.latency.percentile(90)), us(s.latency.percentile(99)),
                   us(s.latency.max));
     lines.emplace_back(buf);
+    if (s.raw_unfused > 0) {  // a raw IMU source without a fusion stage: say why nothing is faired
+      std::snprintf(buf, sizeof buf, ", raw-only %" PRIu64 " (not faired: no orientation, no fusion stage)", s.raw_unfused);
+      lines.back() += buf;
+    }
     if (s.bridging) {
       std::snprintf(buf, sizeof buf, ", bridged gaps %" PRIu64 " (samples %" PRIu64 ")", s.bridged_gaps, s.bridged_samples);
       lines.back() += buf;
@@ -131,6 +135,10 @@ std::string status_line(const std::vector<StreamStats>& now, const std::vector<S
     // What the smoothing is doing: its cutoff now (adapted or fixed), once the rate is known.
     if (s.engine.rate_hz > 0.0) {
       std::snprintf(buf, sizeof buf, " fc %.3gHz%s", s.engine.rotation.cutoff_hz, s.engine.rotation.adaptive ? " (adapted)" : "");
+      out += buf;
+    }
+    if (s.raw_unfused > 0) {
+      std::snprintf(buf, sizeof buf, " raw-only %" PRIu64 " unfused", s.raw_unfused);
       out += buf;
     }
     // A device stream says when its device is away and how often it went: what `systemctl

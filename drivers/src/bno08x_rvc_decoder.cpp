@@ -29,7 +29,9 @@
 //     happened to match).
 //   - The three bytes after the accelerations are not checked: zero on the BNO080, but BNO086
 //     firmware reports motion intent / motion request there (third-party drivers' reading).
-//     The accelerations are not used.
+//   - The accelerations ride with the frame's orientation (kHasAccel), in m/s² = mg · 9.80665e-3
+//     (standard gravity). They include gravity: the document's example reads (-371, -20, 977)
+//     mg, 1.05 g in all, with the module tilted by its roll of 20.85°.
 //   - The index counts reports modulo 256; frame_counter is it unwrapped (each step forward is
 //     (index - previous) mod 256, so fewer than 256 lost frames in a row are assumed; a repeated
 //     index does not advance it). reset() forgets it. There is no device time.
@@ -57,6 +59,7 @@ namespace {
 constexpr std::uint8_t kHeader = 0xAA;
 constexpr std::size_t kFrameSize = kBno08xRvcFrameSize;
 constexpr std::size_t kSummedFirst = 2;   // the index
+constexpr double kMetresPerSecondSquaredPerMilliG = 9.80665e-3;
 constexpr std::size_t kSummedCount = 16;  // index, 12 bytes of angles and accelerations, 3 reserved
 constexpr std::int16_t kMaxYawRoll = 18000;
 constexpr std::int16_t kMaxPitch = 9000;
@@ -141,6 +144,8 @@ class Bno08xRvcDecoder final : public Decoder {
     const std::array<double, 3> deg = {yaw * 0.01, pitch * 0.01, roll * 0.01};
     DecodedSample s;
     s.orientation = euler_to_quat(kZYX, deg);
+    s.accel = Vec3(bytes::le_i16(f + 9), bytes::le_i16(f + 11), bytes::le_i16(f + 13)) * kMetresPerSecondSquaredPerMilliG;
+    s.flags = kHasAccel;
     s.frame_counter = counter_;
     s.has_frame_counter = true;
     ++counters_.samples;
@@ -155,7 +160,7 @@ class Bno08xRvcDecoder final : public Decoder {
 
 }  // namespace
 
-const DecoderEntry kBno08xRvcDecoder{"bno08x-rvc", "CEVA / Hillcrest BNO080, BNO085, BNO086 in UART-RVC mode: yaw, pitch, roll",
+const DecoderEntry kBno08xRvcDecoder{"bno08x-rvc", "CEVA / Hillcrest BNO080, BNO085, BNO086 in UART-RVC mode: yaw, pitch, roll and acceleration",
                                      {}, make_bno08x_rvc_decoder};
 
 std::unique_ptr<Decoder> make_bno08x_rvc_decoder(const OptionMap& options) {

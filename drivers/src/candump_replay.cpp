@@ -19,10 +19,7 @@ class Stamper final : public DecodedSink {
     s.stream_id = options_.stream_id;
     s.sequence = out_.size();
     s.receive_time = receive_time_;
-    s.device_time = d.device_time;
-    s.orientation = d.orientation;
-    s.position = d.position;
-    s.flags = d.flags;
+    fill_sample(d, s);
     const std::optional<double> device = (d.flags & kHasDeviceTime) ? std::optional<double>(d.device_time) : std::nullopt;
     s.time = base_.update(receive_time_, device).time;
     out_.push_back(s);

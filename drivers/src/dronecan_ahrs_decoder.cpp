@@ -34,6 +34,10 @@
 //   sensor -> world: posefair's convention, no conjugate. A non-finite quaternion, or one whose
 //   norm differs from 1 by more than 1e-3 (float16 rounding of a unit quaternion stays within
 //   5e-4), is malformed; otherwise it is normalised.
+// - angular_velocity, float16 x y z, rad/s in the body frame: the gyroscope's reading, carried
+//   beside the orientation (kHasGyro) when all three are finite. linear_acceleration is not
+//   read: the DSDL does not say whether gravity is in it (its name suggests not, and posefair's
+//   accel is the specific force, gravity included), and senders differ.
 // - timestamp: µs, used as device time when non-zero (0 means unknown: no device time). It does
 //   not wrap (56 bits).
 // - transfer id (5 bits, per source node) unwrapped forward-only into frame_counter.
@@ -206,6 +210,13 @@ class DroneCanAhrsDecoder final : public CanDecoder {
     if (usec != 0) {
       out.flags |= kHasDeviceTime;
       out.device_time = static_cast<double>(usec) * 1e-6;
+    }
+    const std::size_t gyro_at = 16 + 2 * static_cast<std::size_t>(p[15] & 0x0F);
+    const Vec3 gyro(half_to_float(bytes::le_u16(&p[gyro_at])), half_to_float(bytes::le_u16(&p[gyro_at + 2])),
+                    half_to_float(bytes::le_u16(&p[gyro_at + 4])));
+    if (gyro.allFinite()) {
+      out.gyro = gyro;
+      out.flags |= kHasGyro;
     }
     out.frame_counter = s.transfer_ids.update(tid);
     out.has_frame_counter = true;

@@ -5,9 +5,13 @@
 // they disagree, this file is wrong). Two forms share one line and may be interleaved:
 // - the text sentence "$PFQ,<time µs>,<w>,<x>,<y>,<z>[,<px>,<py>,<pz>]*HH\r\n", HH the XOR of
 //   the bytes between '$' and '*' (upper or lower case hex);
-// - the binary frame F5 50 | version 1 | flags (bit 0: position) | length | u32 LE time µs |
-//   4 × float32 LE w x y z | [3 × float32 LE position, metres] | CRC-16/CCITT-FALSE LE over
-//   version .. payload end.
+// - the raw-IMU sentence "$PFI,<time µs>,<gx>,<gy>,<gz>,<ax>,<ay>,<az>[,<mx>,<my>,<mz>]*HH\r\n"
+//   (gyroscope rad/s, accelerometer m/s², magnetometer µT, sensor axes): a raw-only sample;
+// - the binary frame F5 50 | version 1 | flags | length | u32 LE time µs | [4 × float32 LE
+//   w x y z, unless flag bit 3] | [3 × float32 LE position, metres, flag bit 0] | [6 × float32
+//   LE gyroscope then accelerometer, flag bit 1] | [3 × float32 LE magnetometer, flag bit 2] |
+//   CRC-16/CCITT-FALSE LE over version .. payload end. Bit 3 (no orientation: a raw-only
+//   sample) needs bit 1 or 2 and excludes bit 0.
 // The device time is a u32 count of microseconds that wraps at 2^32 µs (71.6 min), Arduino's
 // micros(); device_time is it in seconds, unwrapped forward-only (each step modulo 2^32, so a
 // device restart looks like a rollover; reset() starts afresh). The text and binary forms
@@ -26,11 +30,14 @@
 //   frame). A line from '$' to '\n' without a well-formed "*HH" ending, or with a checksum that
 //   does not match, counts as bad_checksum and is dropped whole. Valid sentences of other
 //   types ($GPGGA ...) count as ignored_frames.
-// - Binary frames: a length above 64 counts as malformed at once (no waiting for bytes a
+// - Raw readings must be finite (malformed otherwise); their size is not judged here (a
+//   saturated sensor is the fusion stage's to judge).
+// - Binary frames: a length above 68 counts as malformed at once (no waiting for bytes a
 //   corrupt length announces); after a CRC mismatch only the first sync byte is dropped and the
 //   search goes on inside the rejected bytes. A version other than 1 (with a valid CRC) counts
-//   as ignored_frames: later versions may change the payload. Reserved flag bits set, or a
-//   length other than 20 (32 with position), count as malformed.
+//   as ignored_frames: later versions may change the payload. Reserved flag bits (4-7) set, an
+//   impossible combination, or a length other than the flags give, count as malformed. (A
+//   receiver older than the raw-IMU flags counts such frames malformed, never misreads them.)
 // - Numbers in sentences are read with std::from_chars (no spaces, no '+', no hex); the time
 //   is an unsigned decimal integer up to 4294967295. NaN, infinities, out-of-range numbers, a
 //   quaternion whose norm differs from 1 by more than 1e-3 (the UDP protocol's bound) or a
@@ -46,7 +53,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
 #include <optional>
+#include <string_view>
 
 #include "posefair/drivers/byte_order.hpp"
 #include "posefair/drivers/checksums.hpp"
@@ -59,8 +68,12 @@ constexpr std::uint8_t kSync0 = 0xF5;
 constexpr std::uint8_t kSync1 = 0x50;
 constexpr std::uint8_t kVersion = 1;
 constexpr std::uint8_t kFlagPosition = 0x01;
+constexpr std::uint8_t kFlagImu = 0x02;            // gyroscope and accelerometer follow
+constexpr std::uint8_t kFlagMag = 0x04;            // magnetometer follows
+constexpr std::uint8_t kFlagNoOrientation = 0x08;  // no quaternion: a raw-only sample
+constexpr std::uint8_t kKnownFlags = kFlagPosition | kFlagImu | kFlagMag | kFlagNoOrientation;
 constexpr std::size_t kFrameHeader = 5;       // sync, sync, version, flags, length
-constexpr std::size_t kMaxPayload = 64;
+constexpr std::size_t kMaxPayload = 68;       // time, quaternion, position, gyro + accel, mag
 constexpr std::size_t kMaxSentence = 255;     // '$' through '\n'
 constexpr std::size_t kBufferSize = 1024;
 static_assert(kBufferSize > kMaxSentence && kBufferSize > kFrameHeader + kMaxPayload + 2);
@@ -198,11 +211,13 @@ class PosefairSerialDecoder final : public Decoder {
     const char* s = reinterpret_cast<const char*>(body.data());
     const char* const e = s + body.size();
     const char* comma = std::find(s, e, ',');
-    if (std::string_view(s, static_cast<std::size_t>(comma - s)) != "PFQ") {
+    const std::string_view type(s, static_cast<std::size_t>(comma - s));
+    const bool imu = type == "PFI";
+    if (type != "PFQ" && !imu) {
       ++counters_.ignored_frames;
       return;
     }
-    std::array<std::string_view, 9> fields;
+    std::array<std::string_view, 11> fields;
     std::size_t count = 0;
     while (comma != e) {
       const char* begin = comma + 1;
@@ -213,7 +228,7 @@ class PosefairSerialDecoder final : public Decoder {
       }
       fields[count++] = std::string_view(begin, static_cast<std::size_t>(comma - begin));
     }
-    if (count != 5 && count != 8) {
+    if (imu ? (count != 7 && count != 10) : (count != 5 && count != 8)) {
       ++counters_.malformed;
       return;
     }
@@ -228,7 +243,7 @@ class PosefairSerialDecoder final : public Decoder {
       }
       device_time = unwrap_time(static_cast<std::uint32_t>(t));
     }
-    std::array<double, 7> v{};
+    std::array<double, 10> v{};
     for (std::size_t k = 1; k < count; ++k) {
       const std::string_view f = fields[k];
       const auto [ptr, ec] = std::from_chars(f.data(), f.data() + f.size(), v[k - 1]);
@@ -237,19 +252,31 @@ class PosefairSerialDecoder final : public Decoder {
         return;
       }
     }
+    DecodedSample sample;
+    sample.flags = kHasDeviceTime;
+    sample.device_time = device_time;
+    if (imu) {
+      sample.flags |= kNoOrientation | kHasGyro | kHasAccel;
+      sample.gyro = Vec3(v[0], v[1], v[2]);
+      sample.accel = Vec3(v[3], v[4], v[5]);
+      if (count == 10) {
+        sample.mag = Vec3(v[6], v[7], v[8]);
+        sample.flags |= kHasMag;
+      }
+      ++counters_.samples;
+      sink.on_sample(sample);
+      return;
+    }
     const std::optional<Quat> q = unit(v[0], v[1], v[2], v[3]);
     if (!q) {
       ++counters_.malformed;
       return;
     }
-    DecodedSample sample;
     sample.orientation = *q;
-    sample.flags = kHasDeviceTime;
     if (count == 8) {
       sample.position = Vec3(v[4], v[5], v[6]);
       sample.flags |= kHasPosition;
     }
-    sample.device_time = device_time;
     ++counters_.samples;
     sink.on_sample(sample);
   }
@@ -260,34 +287,61 @@ class PosefairSerialDecoder final : public Decoder {
       ++counters_.ignored_frames;
       return;
     }
-    const bool has_position = (flags & kFlagPosition) != 0;
-    if ((flags & ~kFlagPosition) != 0 || payload.size() != (has_position ? 32u : 20u)) {
+    const bool no_orientation = (flags & kFlagNoOrientation) != 0;
+    if ((flags & ~kKnownFlags) != 0 || payload.size() != frame_payload_size(flags) ||
+        (no_orientation && ((flags & (kFlagImu | kFlagMag)) == 0 || (flags & kFlagPosition) != 0))) {
       ++counters_.malformed;
       return;
     }
     const std::uint8_t* d = payload.data();
     const double device_time = unwrap_time(bytes::le_u32(d));
-    const std::optional<Quat> q =
-        unit(bytes::le_f32(d + 4), bytes::le_f32(d + 8), bytes::le_f32(d + 12), bytes::le_f32(d + 16));
-    if (!q) {
-      ++counters_.malformed;
-      return;
-    }
+    std::size_t at = 4;
+    const auto vec3 = [&] {
+      const Vec3 v(bytes::le_f32(d + at), bytes::le_f32(d + at + 4), bytes::le_f32(d + at + 8));
+      at += 12;
+      return v;
+    };
     DecodedSample sample;
-    sample.orientation = *q;
     sample.flags = kHasDeviceTime;
-    if (has_position) {
-      const Vec3 pos(bytes::le_f32(d + 20), bytes::le_f32(d + 24), bytes::le_f32(d + 28));
-      if (!pos.allFinite()) {
+    sample.device_time = device_time;
+    if (no_orientation) {
+      sample.flags |= kNoOrientation;
+    } else {
+      const std::optional<Quat> q =
+          unit(bytes::le_f32(d + 4), bytes::le_f32(d + 8), bytes::le_f32(d + 12), bytes::le_f32(d + 16));
+      if (!q) {
         ++counters_.malformed;
         return;
       }
-      sample.position = pos;
+      sample.orientation = *q;
+      at += 16;
+    }
+    if ((flags & kFlagPosition) != 0) {
+      sample.position = vec3();
       sample.flags |= kHasPosition;
     }
-    sample.device_time = device_time;
+    if ((flags & kFlagImu) != 0) {
+      sample.gyro = vec3();
+      sample.accel = vec3();
+      sample.flags |= kHasGyro | kHasAccel;
+    }
+    if ((flags & kFlagMag) != 0) {
+      sample.mag = vec3();
+      sample.flags |= kHasMag;
+    }
+    if (!sample.position.allFinite() || !sample.gyro.allFinite() || !sample.accel.allFinite() ||
+        !sample.mag.allFinite()) {
+      ++counters_.malformed;
+      return;
+    }
     ++counters_.samples;
     sink.on_sample(sample);
+  }
+
+  // The payload length the flags announce.
+  static std::size_t frame_payload_size(std::uint8_t flags) {
+    return 4 + ((flags & kFlagNoOrientation) ? 0 : 16) + ((flags & kFlagPosition) ? 12 : 0) +
+           ((flags & kFlagImu) ? 24 : 0) + ((flags & kFlagMag) ? 12 : 0);
   }
 
   detail::MessageBuffer<kBufferSize> buffer_;
@@ -304,7 +358,7 @@ void append_number(std::string& out, double v) {
 
 }  // namespace
 
-const DecoderEntry kPosefairSerialDecoder{"posefair", "posefair's own protocol for microcontrollers: $PFQ text and F5 50 frames",
+const DecoderEntry kPosefairSerialDecoder{"posefair", "posefair's own protocol for microcontrollers: $PFQ/$PFI text and F5 50 frames, orientation and raw IMU",
                                           {}, make_posefair_serial_decoder};
 
 std::unique_ptr<Decoder> make_posefair_serial_decoder(const OptionMap& options) {
@@ -312,18 +366,23 @@ std::unique_ptr<Decoder> make_posefair_serial_decoder(const OptionMap& options) 
   return std::make_unique<PosefairSerialDecoder>();
 }
 
-std::string encode_posefair_sentence(std::uint32_t device_time_us, const Quat& q, const Vec3* position) {
-  std::string s = "$PFQ,";
+namespace {
+// "$<type>,<time>,<numbers...>*HH\r\n".
+std::string sentence(std::string_view type, std::uint32_t device_time_us, std::initializer_list<const double*> runs,
+                     std::initializer_list<std::size_t> lengths) {
+  std::string s = "$";
+  s += type;
+  s += ',';
   s += std::to_string(device_time_us);
-  for (double v : {q.w(), q.x(), q.y(), q.z()}) {
-    s += ',';
-    append_number(s, v);
-  }
-  if (position)
-    for (int k = 0; k < 3; ++k) {
+  auto length = lengths.begin();
+  for (const double* run : runs) {
+    const std::size_t n = *length++;
+    if (run == nullptr) continue;
+    for (std::size_t k = 0; k < n; ++k) {
       s += ',';
-      append_number(s, (*position)[k]);
+      append_number(s, run[k]);
     }
+  }
   const std::uint8_t x =
       checksum::xor8({reinterpret_cast<const std::uint8_t*>(s.data()) + 1, s.size() - 1});
   constexpr char kHex[] = "0123456789ABCDEF";
@@ -333,22 +392,42 @@ std::string encode_posefair_sentence(std::uint32_t device_time_us, const Quat& q
   s += "\r\n";
   return s;
 }
+}  // namespace
+
+std::string encode_posefair_sentence(std::uint32_t device_time_us, const Quat& q, const Vec3* position) {
+  const double wxyz[4] = {q.w(), q.x(), q.y(), q.z()};
+  return sentence("PFQ", device_time_us, {wxyz, position ? position->data() : nullptr}, {4, 3});
+}
+
+std::string encode_posefair_imu_sentence(std::uint32_t device_time_us, const Vec3& gyro, const Vec3& accel,
+                                         const Vec3* mag) {
+  return sentence("PFI", device_time_us, {gyro.data(), accel.data(), mag ? mag->data() : nullptr}, {3, 3, 3});
+}
 
 std::vector<std::uint8_t> encode_posefair_frame(std::uint32_t device_time_us, const Quat& q, const Vec3* position) {
-  const std::size_t len = position ? 32 : 20;
-  std::vector<std::uint8_t> f(kFrameHeader + len + 2);
-  f[0] = kSync0;
-  f[1] = kSync1;
-  f[2] = kVersion;
-  f[3] = position ? kFlagPosition : 0;
+  return encode_posefair_frame(device_time_us, &q, position, nullptr, nullptr);
+}
+
+std::vector<std::uint8_t> encode_posefair_frame(std::uint32_t device_time_us, const Quat* q, const Vec3* position,
+                                                const PosefairImuReading* imu, const Vec3* mag) {
+  const auto flags = static_cast<std::uint8_t>((q ? 0 : kFlagNoOrientation) | (position ? kFlagPosition : 0) |
+                                               (imu ? kFlagImu : 0) | (mag ? kFlagMag : 0));
+  std::vector<std::uint8_t> f = {kSync0, kSync1, kVersion, flags, 0};
+  const auto put = [&](double v) {
+    f.resize(f.size() + 4);
+    bytes::put_le_f32(f.data() + f.size() - 4, static_cast<float>(v));
+  };
+  f.resize(f.size() + 4);
+  bytes::put_le_u32(f.data() + kFrameHeader, device_time_us);
+  if (q)
+    for (double v : {q->w(), q->x(), q->y(), q->z()}) put(v);
+  for (const Vec3* v : {position, imu ? &imu->gyro : nullptr, imu ? &imu->accel : nullptr, mag})
+    if (v)
+      for (int k = 0; k < 3; ++k) put((*v)[k]);
+  const std::size_t len = f.size() - kFrameHeader;
   f[4] = static_cast<std::uint8_t>(len);
-  std::uint8_t* d = f.data() + kFrameHeader;
-  bytes::put_le_u32(d, device_time_us);
-  const double comps[4] = {q.w(), q.x(), q.y(), q.z()};
-  for (int k = 0; k < 4; ++k) bytes::put_le_f32(d + 4 + 4 * k, static_cast<float>(comps[k]));
-  if (position)
-    for (int k = 0; k < 3; ++k) bytes::put_le_f32(d + 20 + 4 * k, static_cast<float>((*position)[k]));
-  bytes::put_le_u16(d + len, checksum::crc16_ccitt({f.data() + 2, 3 + len}, 0xFFFF));
+  f.resize(f.size() + 2);
+  bytes::put_le_u16(f.data() + kFrameHeader + len, checksum::crc16_ccitt({f.data() + 2, 3 + len}, 0xFFFF));
   return f;
 }
 

@@ -27,14 +27,9 @@ class SampleStamper final : public DecodedSink {
     s.stream_id = stream_id_;
     s.sequence = sequence_++;
     s.receive_time = receive_time_;
-    s.orientation = d.orientation;
-    s.flags = d.flags & (kHasPosition | kHasDeviceTime);
-    if (s.has_position()) s.position = d.position;
+    fill_sample(d, s);
     std::optional<double> device;
-    if ((s.flags & kHasDeviceTime) != 0) {
-      s.device_time = d.device_time;
-      device = d.device_time;
-    }
+    if ((s.flags & kHasDeviceTime) != 0) device = d.device_time;
     s.time = time_base_.update(receive_time_, device).time;
     if (sink_.push(s))
       samples_.fetch_add(1, std::memory_order_relaxed);

@@ -21,7 +21,7 @@
 // "$VNYPR,+010.071,+000.278,-002.026,T1162704*2F"); SerialStatus appends a status field the
 // same way. Up to two such trailing fields starting with 'T' or 'S' are accepted and not read.
 //
-// Outputs decoded (any other valid sentence, e.g. $VNINS, $VNIMU, $VNMAR, $VNRRG/$VNWRG
+// Outputs decoded (any other valid sentence, e.g. $VNINS, $VNRRG/$VNWRG
 // responses, $VNERR, counts as ignored_frames):
 //  - VNQMR (register 15): quaternion x, y, z, w ("Quat[3] ... Scalar component"), magnetic,
 //    acceleration, angular rate: 13 numbers.      - VNQTN (register 9): the quaternion alone.
@@ -29,6 +29,18 @@
 //    numbers.                                       - VNYPR (register 8): the three angles alone.
 // The brief asked for VNQMR and VNYMR; VNQTN and VNYPR carry the same attitude in the same
 // conventions, so a device left at ADOR 1 or 2 works too.
+//
+// Raw inertial readings (UM001 §7.2.4-§7.2.8, §6.1.1; units as the tables give them): the
+// magnetic field in Gauss (µT = 100 · Gauss), acceleration in m/s², angular rate in rad/s, all
+// in the body frame. VNQMR and VNYMR carry the compensated ones beside the attitude: the
+// sample has both. Sentences with readings and no attitude give a raw-only sample
+// (kNoOrientation):
+//  - VNMAR (register 20): magnetic, acceleration, angular rate (compensated): 9 numbers;
+//  - VNIMU (register 54): the uncompensated magnetic, acceleration, angular rate, then
+//    temperature and pressure (not read): 11 numbers;
+//  - VNMAG, VNACC, VNGYR (registers 17, 18, 19): one of the three: 3 numbers.
+// Values must be finite; the readings are not range-checked (a saturated sensor is the fusion
+// stage's to judge).
 //
 // Conventions. posefair's sample q rotates sensor coordinates into world coordinates,
 // v_world = q v_sensor q*. VectorNav's world frame is the local North-East-Down frame and its
@@ -97,25 +109,31 @@ namespace {
 constexpr double kUnitTolerance = 1e-3;
 constexpr std::size_t kMaxNumbers = 13;
 
-enum class Kind { kQmr, kYmr, kQtn, kYpr, kOther };
+constexpr double kMicroteslaPerGauss = 100.0;
 
-Kind kind_of(std::string_view header) {
-  if (header == "VNQMR") return Kind::kQmr;
-  if (header == "VNYMR") return Kind::kYmr;
-  if (header == "VNQTN") return Kind::kQtn;
-  if (header == "VNYPR") return Kind::kYpr;
-  return Kind::kOther;
-}
+enum class Attitude { kQuaternion, kYawPitchRoll, kNone };
 
-std::size_t numbers_of(Kind k) {
-  switch (k) {
-    case Kind::kQmr: return 13;
-    case Kind::kYmr: return 12;
-    case Kind::kQtn: return 4;
-    case Kind::kYpr: return 3;
-    case Kind::kOther: break;
-  }
-  return 0;
+// Each output read: its header, how many numbers it has, its attitude, and where its magnetic,
+// acceleration and angular rate triples start (-1: not in it).
+struct Output {
+  std::string_view header;
+  std::size_t numbers;
+  Attitude attitude;
+  int mag, accel, gyro;
+};
+
+constexpr Output kOutputs[] = {
+    {"VNQMR", 13, Attitude::kQuaternion, 4, 7, 10},  {"VNYMR", 12, Attitude::kYawPitchRoll, 3, 6, 9},
+    {"VNQTN", 4, Attitude::kQuaternion, -1, -1, -1}, {"VNYPR", 3, Attitude::kYawPitchRoll, -1, -1, -1},
+    {"VNMAR", 9, Attitude::kNone, 0, 3, 6},          {"VNIMU", 11, Attitude::kNone, 0, 3, 6},
+    {"VNMAG", 3, Attitude::kNone, 0, -1, -1},        {"VNACC", 3, Attitude::kNone, -1, 0, -1},
+    {"VNGYR", 3, Attitude::kNone, -1, -1, 0},
+};
+
+const Output* output_of(std::string_view header) {
+  for (const Output& o : kOutputs)
+    if (o.header == header) return &o;
+  return nullptr;
 }
 
 int hex_value(char c) {
@@ -244,12 +262,12 @@ class VectorNavDecoder final : public Decoder {
 
   void decode(std::string_view body, bool strict, DecodedSink& sink) {
     const std::size_t comma = body.find(',');
-    const Kind kind = kind_of(body.substr(0, comma));
-    if (kind == Kind::kOther) {
+    const Output* const out = output_of(body.substr(0, comma));
+    if (out == nullptr) {
       ++counters_.ignored_frames;
       return;
     }
-    const std::size_t expected = numbers_of(kind);
+    const std::size_t expected = out->numbers;
     std::array<double, kMaxNumbers> v{};
     std::size_t count = 0;
     std::size_t extras = 0;
@@ -270,20 +288,34 @@ class VectorNavDecoder final : public Decoder {
     }
     if (count < expected) return malformed();
 
-    Quat q;
-    if (kind == Kind::kQmr || kind == Kind::kQtn) {
-      q = Quat(v[3], v[0], v[1], v[2]);  // scalar last on the wire
+    DecodedSample sample;
+    if (out->attitude == Attitude::kQuaternion) {
+      Quat q(v[3], v[0], v[1], v[2]);  // scalar last on the wire
       const double norm = q.norm();
       if (!(std::abs(norm - 1.0) <= kUnitTolerance)) return malformed();
       q.coeffs() /= norm;
-    } else {
+      sample.orientation = q;
+    } else if (out->attitude == Attitude::kYawPitchRoll) {
       if (!(std::abs(v[0]) <= 180.0 && std::abs(v[1]) <= 90.0 && std::abs(v[2]) <= 180.0)) return malformed();
       static constexpr std::array<Axis, 3> kZyx = {Axis::Z, Axis::Y, Axis::X};
       const std::array<double, 3> ypr = {v[0], v[1], v[2]};
-      q = euler_to_quat(kZyx, ypr);
+      sample.orientation = euler_to_quat(kZyx, ypr);
+    } else {
+      sample.flags |= kNoOrientation;
     }
-    DecodedSample sample;
-    sample.orientation = q;
+    const auto triple = [&](int at) { return Vec3(v[at], v[at + 1], v[at + 2]); };
+    if (out->mag >= 0) {
+      sample.mag = triple(out->mag) * kMicroteslaPerGauss;
+      sample.flags |= kHasMag;
+    }
+    if (out->accel >= 0) {
+      sample.accel = triple(out->accel);
+      sample.flags |= kHasAccel;
+    }
+    if (out->gyro >= 0) {
+      sample.gyro = triple(out->gyro);
+      sample.flags |= kHasGyro;
+    }
     ++counters_.samples;
     sink.on_sample(sample);
   }
@@ -325,7 +357,7 @@ constexpr OptionSpec kOptions[] = {
 };
 }  // namespace
 
-const DecoderEntry kVectorNavDecoder{"vectornav", "VectorNav VN-100/200/300 ASCII: $VNQMR, $VNYMR and kin", kOptions,
+const DecoderEntry kVectorNavDecoder{"vectornav", "VectorNav VN-100/200/300 ASCII: $VNQMR, $VNYMR and kin, with $VNMAR/$VNIMU raw readings", kOptions,
                                      make_vectornav_decoder};
 
 std::unique_ptr<Decoder> make_vectornav_decoder(const OptionMap& options) {

@@ -26,12 +26,30 @@
 //   0x50 time: YY MM DD hh mm ss, then milliseconds (16 bit). The document's checksum line for
 //     this packet reads "0x55+0x51+...+TL" (copied from 0x51); the device sums the first 10 bytes
 //     like every other packet, and so does this decoder.
-//   0x51 accel, 0x52 gyro, 0x54 mag, 0x55 port, 0x56 pressure, 0x57/0x58/0x5A GPS, and the
-//     undocumented 0x5B..0x5F: valid frames, counted as ignored_frames. A type byte outside
+//   0x51 acceleration: ax ay az = int16 / 32768 · 16 g, "g is Gravity acceleration, 9.8m/s2"
+//     (HWT905-TTL "Protocol", Acceleration Output): m/s² = int16 · 16 · 9.8 / 32768; then a
+//     temperature word, unused.
+//   0x52 angular velocity: wx wy wz = int16 / 32768 · 2000 °/s (same page, Angular Velocity
+//     Output): rad/s = int16 · 2000 / 32768 · π/180; then a temperature word, unused.
+//   0x54 magnetic field: Hx Hy Hz = int16 (WT901 Datasheet 5.1.5 gives no unit; the WT901BLECL
+//     Datasheet v20-0707, 6.1.2.1, reading the same registers, says "Unit: mG"): µT = int16 ·
+//     0.1. Its example (x = 360, y = 105, z = 122 mG, |H| = 39 µT) is an earth field's size.
+//   0x55 port, 0x56 pressure, 0x57/0x58/0x5A GPS, and the undocumented 0x5B..0x5F: valid
+//     frames, counted as ignored_frames. A type byte outside
 //     0x50..0x5F is not a frame start (the 0x55 is skipped as garbage), which makes a false
 //     start in garbage 16 times rarer than accepting any type.
 //
 // Choices:
+//   - Raw readings (0x51, 0x52, 0x54) ride with the orientation of their output cycle. The
+//     device sends a cycle's packets in ascending type order, so the acceleration and angular
+//     velocity (and the magnetic field, before a 0x59) arrive before the cycle's orientation
+//     frame: they are held and the orientation sample carries them (kHasAccel, kHasGyro,
+//     kHasMag). Readings that no orientation follows in their cycle (the device streams raw
+//     data only, the orientation frame was lost, or 0x54 comes after an angles-only 0x53) are
+//     sent alone as a raw-only sample (kNoOrientation) when the cycle ends: at the next cycle's
+//     first packet, or, once two cycles in a row ended so at the same packet type, at that type
+//     (without waiting; one lost orientation frame does not teach a wrong end). A reading of a
+//     type already held replaces it.
 //   - Quaternion preferred: a device may send both 0x53 and 0x59 each cycle; once a 0x59 has
 //     been seen, 0x53 frames are ignored_frames. Two 0x53 frames with no 0x59 between them mean
 //     the quaternion output was switched off, and 0x53 frames produce samples again (so the
@@ -47,7 +65,8 @@
 //   - The decoder never remaps axes: the WT901 datasheet draws X right / Y forward / Z up, the
 //     WT901BLECL one X forward / Y left / Z up; samples are in the module's own axes, world
 //     frame east-north-up ("northeast sky") with yaw relative to the module's reference.
-//   - Every valid frame lands in exactly one of: a sample, ignored_frames, malformed. Bytes not
+//   - Every valid frame lands in exactly one of: a sample (its orientation or one of its raw
+//     readings), ignored_frames, malformed. Bytes not
 //     part of a valid frame are skipped_bytes; each run of them is one resync. A frame whose
 //     checksum fails counts in bad_checksum, and the search resumes at its second byte (so a
 //     good frame starting inside it is still found).
@@ -57,6 +76,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -71,10 +91,16 @@ namespace {
 constexpr std::uint8_t kHeader = 0x55;
 constexpr std::size_t kFrameSize = kWitMotionFrameSize;
 constexpr std::uint8_t kTypeTime = 0x50;
+constexpr std::uint8_t kTypeAccel = 0x51;
+constexpr std::uint8_t kTypeGyro = 0x52;
 constexpr std::uint8_t kTypeAngles = 0x53;
+constexpr std::uint8_t kTypeMag = 0x54;
 constexpr std::uint8_t kTypeQuaternion = 0x59;
 constexpr double kQuatScale = 1.0 / 32768.0;
 constexpr double kAngleScale = 180.0 / 32768.0;
+constexpr double kAccelScale = 16.0 * 9.8 / 32768.0;                          // m/s² per count
+constexpr double kGyroScale = 2000.0 / 32768.0 * std::numbers::pi / 180.0;  // rad/s per count
+constexpr double kMagScale = 0.1;                                             // µT per count (mG)
 constexpr std::int64_t kDayMs = 86'400'000;
 
 bool is_frame_type(std::uint8_t type) { return (type & 0xF0u) == 0x50u; }
@@ -113,6 +139,11 @@ class WitMotionDecoder final : public Decoder {
     last_time_of_day_ms_ = 0;
     day_offset_ms_ = 0;
     cycle_types_ = 0;
+    raw_ = {};
+    last_type_ = 0;
+    leftover_end_type_ = 0;
+    cycle_end_type_ = 0;
+    flushed_early_ = false;
   }
 
  private:
@@ -155,20 +186,53 @@ class WitMotionDecoder final : public Decoder {
     const std::uint8_t* d = f + 2;
     const auto bit = static_cast<std::uint16_t>(1u << (type & 0x0Fu));
     if (type == kTypeTime) {
+      end_cycle(sink);
+      last_type_ = type;
       cycle_types_ = bit;
       on_time(d);
       return;
     }
     if ((cycle_types_ & bit) != 0) {  // a new cycle began without its time frame
+      end_cycle(sink);
       time_valid_ = false;
       cycle_types_ = 0;
     }
     cycle_types_ = static_cast<std::uint16_t>(cycle_types_ | bit);
+    last_type_ = type;
     switch (type) {
       case kTypeQuaternion: on_quaternion(d, sink); break;
       case kTypeAngles: on_angles(d, sink); break;
+      case kTypeAccel: on_raw(kHasAccel, raw_.accel, d, kAccelScale, type, sink); break;
+      case kTypeGyro: on_raw(kHasGyro, raw_.gyro, d, kGyroScale, type, sink); break;
+      case kTypeMag: on_raw(kHasMag, raw_.mag, d, kMagScale, type, sink); break;
       default: ++counters_.ignored_frames; break;
     }
+  }
+
+  // The cycle is over: readings no orientation took go out alone. Two cycles in a row that
+  // ended so, at the same packet type, make that type the end of the next cycle's raw part.
+  void end_cycle(DecodedSink& sink) {
+    const bool leftover = raw_.flags != 0 || flushed_early_;
+    if (raw_.flags != 0) emit_raw_only(sink);
+    cycle_end_type_ = leftover && last_type_ == leftover_end_type_ ? last_type_ : 0;
+    leftover_end_type_ = leftover ? last_type_ : 0;
+    flushed_early_ = false;
+  }
+
+  void on_raw(std::uint32_t flag, Vec3& into, const std::uint8_t* d, double scale, std::uint8_t type,
+              DecodedSink& sink) {
+    into = Vec3(bytes::le_i16(d), bytes::le_i16(d + 2), bytes::le_i16(d + 4)) * scale;
+    raw_.flags |= flag;
+    if (type == cycle_end_type_) {  // the last packet of a cycle: no orientation follows
+      emit_raw_only(sink);
+      flushed_early_ = true;
+    }
+  }
+
+  void emit_raw_only(DecodedSink& sink) {
+    DecodedSample s;
+    s.flags = kNoOrientation;
+    emit(s, sink);
   }
 
   void on_time(const std::uint8_t* d) {
@@ -202,7 +266,9 @@ class WitMotionDecoder final : public Decoder {
     quaternion_seen_ = true;
     angles_since_quaternion_ = 0;
     q.coeffs() /= norm;
-    emit(q, sink);
+    DecodedSample s;
+    s.orientation = q;
+    emit(s, sink);
   }
 
   void on_angles(const std::uint8_t* d, DecodedSink& sink) {
@@ -220,12 +286,18 @@ class WitMotionDecoder final : public Decoder {
     static constexpr std::array<Axis, 3> kZYX = {Axis::Z, Axis::Y, Axis::X};
     const std::array<double, 3> deg = {bytes::le_i16(d + 4) * kAngleScale, pitch_raw * kAngleScale,
                                        bytes::le_i16(d) * kAngleScale};
-    emit(euler_to_quat(kZYX, deg), sink);
+    DecodedSample s;
+    s.orientation = euler_to_quat(kZYX, deg);
+    emit(s, sink);
   }
 
-  void emit(const Quat& q, DecodedSink& sink) {
-    DecodedSample s;
-    s.orientation = q;
+  // Sends s with the held raw readings and the cycle's device time.
+  void emit(DecodedSample& s, DecodedSink& sink) {
+    s.flags |= raw_.flags;
+    s.gyro = raw_.gyro;
+    s.accel = raw_.accel;
+    s.mag = raw_.mag;
+    raw_ = {};
     if (time_valid_) {
       s.flags |= kHasDeviceTime;
       s.device_time = time_;
@@ -244,6 +316,14 @@ class WitMotionDecoder final : public Decoder {
   std::int64_t last_time_of_day_ms_ = 0;
   std::int64_t day_offset_ms_ = 0;
   std::uint16_t cycle_types_ = 0;  // bit (type & 15) for each packet type seen since the last 0x50
+  struct Raw {
+    std::uint32_t flags = 0;  // kHasAccel, kHasGyro, kHasMag held for the cycle's sample
+    Vec3 gyro = Vec3::Zero(), accel = Vec3::Zero(), mag = Vec3::Zero();
+  } raw_;
+  std::uint8_t last_type_ = 0;           // the type of the current cycle's latest frame
+  std::uint8_t leftover_end_type_ = 0;   // the last type of the previous cycle if readings were left over, else 0
+  std::uint8_t cycle_end_type_ = 0;      // send readings alone at this type (0: wait for the cycle's end)
+  bool flushed_early_ = false;           // this cycle's readings went out at cycle_end_type_
 };
 
 }  // namespace
@@ -256,7 +336,7 @@ constexpr OptionSpec kOptions[] = {
 };
 }  // namespace
 
-const DecoderEntry kWitMotionDecoder{"witmotion", "WitMotion WT901 family: 0x55 frames, quaternion (0x59) or angles (0x53)",
+const DecoderEntry kWitMotionDecoder{"witmotion", "WitMotion WT901 family: 0x55 frames, quaternion (0x59) or angles (0x53), with acceleration, angular velocity and magnetic field (0x51, 0x52, 0x54)",
                                      kOptions, make_witmotion_decoder};
 
 std::unique_ptr<Decoder> make_witmotion_decoder(const OptionMap& options) {
@@ -294,6 +374,16 @@ std::array<std::uint8_t, kWitMotionFrameSize> encode_witmotion_angles(double rol
   bytes::put_le_u16(data.data() + 4, wrap_i16(yaw_deg / kAngleScale));
   bytes::put_le_u16(data.data() + 6, version);
   return encode_witmotion_frame(kTypeAngles, data);
+}
+
+std::array<std::uint8_t, kWitMotionFrameSize> encode_witmotion_vector(std::uint8_t type, const Vec3& v,
+                                                                      std::uint16_t temperature) {
+  const double scale = type == kTypeAccel ? kAccelScale : type == kTypeGyro ? kGyroScale : kMagScale;
+  std::array<std::uint8_t, 8> data{};
+  for (int i = 0; i < 3; ++i)
+    bytes::put_le_u16(data.data() + 2 * i, static_cast<std::uint16_t>(saturate_i16(v[i] / scale)));
+  bytes::put_le_u16(data.data() + 6, temperature);
+  return encode_witmotion_frame(type, data);
 }
 
 std::array<std::uint8_t, kWitMotionFrameSize> encode_witmotion_time(int yy, int month, int day, int hour, int minute,

@@ -35,6 +35,17 @@
 //   quaternion is Fp1632 counts as ignored. A quaternion whose norm differs from 1 by more
 //   than 1e-3, or that is not finite, makes the message malformed; otherwise it is normalised.
 //   If a message carries several quaternion packets, the first decodable one is used.
+// - Raw inertial data, in the sensor frame S, each 3 numbers in the id's number format (Float32,
+//   Fp1220 or Float64; Fp1632 skipped as for the quaternion), MT0101P's units:
+//   0x402x Acceleration, m/s² -> accel (kHasAccel); 0x802x RateOfTurn, rad/s -> gyro
+//   (kHasGyro); 0xC02x MagneticField, "a.u." (arbitrary units: 1 is the field strength where
+//   the device's magnetic field mapping was done) -> mag (kHasMag) in µT = a.u. ·
+//   xsens_mag_field (default 50 µT, a mid-latitude field; set the local strength if a fusion
+//   stage needs the magnitude, the direction does not depend on it). FreeAcceleration (0x4030),
+//   DeltaV (0x4010) and DeltaQ (0x8030) are not readings of the sensors and are not read.
+//   They ride with the message's quaternion; a message with raw data but no quaternion (an MTi
+//   sends each output at its own rate, or an MTi-1 IMU without a filter) gives a raw-only
+//   sample (kNoOrientation). A non-finite reading makes the message malformed.
 // - 0x1020 PacketCounter (u16, wraps at 2^16) -> frame_counter, unwrapped.
 // - 0x1060 SampleTimeFine (u32, 10 kHz ticks, wraps at 2^32 = 4.97 days) -> device_time in s,
 //   unwrapped.
@@ -47,7 +58,7 @@
 // - MTi devices always send bus id 0xFF ("master device"); other bus ids (old Xbus Master
 //   systems) are not accepted as a frame start, which makes false starts 256 times rarer.
 // - Messages other than MTData2 (WakeUp 0x3E, Error 0x42, acknowledgements, Configuration ...)
-//   and MTData2 messages without a decodable quaternion count as ignored_frames.
+//   and MTData2 messages without a decodable quaternion or raw reading count as ignored_frames.
 // - A data length above 2048 bytes (kMaxData; the eMTS message an MTi sends before it starts
 //   measuring is about 1.3 KB, MTData2 messages are far shorter) counts as malformed without
 //   waiting for the bytes it announces, so a corrupt extended length never stalls the stream;
@@ -87,6 +98,9 @@ static_assert(kBufferSize > kMaxMessage);
 constexpr std::uint16_t kPacketCounter = 0x1020;
 constexpr std::uint16_t kSampleTimeFine = 0x1060;
 constexpr std::uint16_t kQuaternion = 0x2010;
+constexpr std::uint16_t kAcceleration = 0x4020;
+constexpr std::uint16_t kRateOfTurn = 0x8020;
+constexpr std::uint16_t kMagneticField = 0xC020;
 constexpr double kSampleTimeFineHz = 10000.0;
 constexpr double kUnitTolerance = 1e-3;
 
@@ -96,6 +110,8 @@ std::uint64_t be_u64(const std::uint8_t* p) {
 
 class XsensDecoder final : public Decoder {
  public:
+  explicit XsensDecoder(double mag_ut_per_au) : mag_ut_per_au_(mag_ut_per_au) {}
+
   std::string_view protocol() const override { return "xsens"; }
 
   void feed(std::span<const std::uint8_t> in, DecodedSink& sink) override {
@@ -190,7 +206,32 @@ class XsensDecoder final : public Decoder {
     return std::nullopt;
   }
 
+  // One 3-vector packet's payload, or nothing for Fp1632 (see the quaternion).
+  static std::optional<Vec3> read_vector(std::uint16_t id, const std::uint8_t* d, std::size_t size, bool& bad_size) {
+    Vec3 v;
+    switch (id & 0x3) {
+      case 0:
+        if (size != 12) break;
+        for (int k = 0; k < 3; ++k) v[k] = bytes::be_f32(d + 4 * k);
+        return v;
+      case 1:
+        if (size != 12) break;
+        for (int k = 0; k < 3; ++k) v[k] = static_cast<double>(static_cast<std::int32_t>(bytes::be_u32(d + 4 * k))) / 1048576.0;
+        return v;
+      case 2:
+        if (size != 18) break;
+        return std::nullopt;
+      default:
+        if (size != 24) break;
+        for (int k = 0; k < 3; ++k) v[k] = std::bit_cast<double>(be_u64(d + 8 * k));
+        return v;
+    }
+    bad_size = true;
+    return std::nullopt;
+  }
+
   void handle_mtdata2(std::span<const std::uint8_t> data, DecodedSink& sink) {
+    DecodedSample s;
     std::optional<std::uint16_t> counter;
     std::optional<std::uint32_t> time;
     std::optional<std::array<double, 4>> quat;
@@ -217,6 +258,12 @@ class XsensDecoder final : public Decoder {
       } else if ((id & 0xFFF0) == kQuaternion && (id & 0xC) != 0xC) {
         std::optional<std::array<double, 4>> q = read_quaternion(id, payload, size, bad_size);
         if (q && !quat) quat = q;
+      } else if ((id & 0xFFF0) == kAcceleration) {
+        read_raw(kHasAccel, s.accel, 1.0, id, payload, size, bad_size, s.flags);
+      } else if ((id & 0xFFF0) == kRateOfTurn) {
+        read_raw(kHasGyro, s.gyro, 1.0, id, payload, size, bad_size, s.flags);
+      } else if ((id & 0xFFF0) == kMagneticField) {
+        read_raw(kHasMag, s.mag, mag_ut_per_au_, id, payload, size, bad_size, s.flags);
       }
       if (bad_size) {
         ++counters_.malformed;
@@ -225,7 +272,10 @@ class XsensDecoder final : public Decoder {
       pos += 3 + size;
     }
 
-    DecodedSample s;
+    if (!s.accel.allFinite() || !s.gyro.allFinite() || !s.mag.allFinite()) {
+      ++counters_.malformed;
+      return;
+    }
     if (counter) {
       s.frame_counter = counter_.update(*counter);
       s.has_frame_counter = true;
@@ -235,7 +285,13 @@ class XsensDecoder final : public Decoder {
       s.flags |= kHasDeviceTime;
     }
     if (!quat) {
-      ++counters_.ignored_frames;
+      if ((s.flags & (kHasAccel | kHasGyro | kHasMag)) == 0) {
+        ++counters_.ignored_frames;
+        return;
+      }
+      s.flags |= kNoOrientation;
+      ++counters_.samples;
+      sink.on_sample(s);
       return;
     }
     const Quat q((*quat)[0], (*quat)[1], (*quat)[2], (*quat)[3]);
@@ -249,6 +305,16 @@ class XsensDecoder final : public Decoder {
     sink.on_sample(s);
   }
 
+  // The first decodable packet of a kind is used, as for the quaternion.
+  static void read_raw(std::uint32_t flag, Vec3& into, double scale, std::uint16_t id, const std::uint8_t* payload,
+                       std::size_t size, bool& bad_size, std::uint32_t& flags) {
+    const std::optional<Vec3> v = read_vector(id, payload, size, bad_size);
+    if (!v || (flags & flag) != 0) return;
+    into = *v * scale;
+    flags |= flag;
+  }
+
+  const double mag_ut_per_au_;
   detail::MessageBuffer<kBufferSize> buffer_;
   CounterUnwrapper counter_{16};
   CounterUnwrapper time_{32};
@@ -256,12 +322,21 @@ class XsensDecoder final : public Decoder {
 
 }  // namespace
 
-const DecoderEntry kXsensDecoder{"xsens", "Xsens MTi series over a UART: Xbus MTData2 with a quaternion", {},
-                                 make_xsens_decoder};
+namespace {
+constexpr OptionSpec kOptions[] = {
+    {"xsens_mag_field", OptionType::Float, "50.0",
+     "µT that one arbitrary unit of the MagneticField output stands for (the field strength where the magnetic field mapping was done)"},
+};
+}  // namespace
+
+const DecoderEntry kXsensDecoder{"xsens", "Xsens MTi series over a UART: Xbus MTData2 with a quaternion, acceleration, rate of turn, magnetic field",
+                                 kOptions, make_xsens_decoder};
 
 std::unique_ptr<Decoder> make_xsens_decoder(const OptionMap& options) {
-  (void)OptionReader({}, options);  // it reads none: refuses any
-  return std::make_unique<XsensDecoder>();
+  const OptionReader read(kOptions, options);
+  const double field = read.real("xsens_mag_field");
+  if (!(field > 0.0 && field < 1000.0)) throw OptionError("xsens_mag_field", "must be a field strength in µT, above 0 and below 1000");
+  return std::make_unique<XsensDecoder>(field);
 }
 
 std::vector<std::uint8_t> encode_xsens_mtdata2(const Quat& q, std::optional<std::uint16_t> packet_counter,

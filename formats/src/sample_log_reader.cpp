@@ -63,6 +63,14 @@ Sample decode_sample_body(const unsigned char* b) {
   return s;
 }
 
+Sample decode_imu_sample_body(const unsigned char* b) {
+  Sample s = decode_sample_body(b);
+  const unsigned char* p = b + kSampleBodyBytes;
+  for (Vec3* v : {&s.gyro, &s.accel, &s.mag})
+    for (int k = 0; k < 3; ++k, p += 8) (*v)[k] = get_f64(p);
+  return s;
+}
+
 // ---------------------------------------------------------------------------------------------
 // SampleLogReader
 
@@ -253,12 +261,17 @@ bool SampleLogReader::next(Sample& out) {
                          std::to_string(kSampleBodyBytes) + ")");
       return false;
     }
+    if (type == RecordType::ImuSample && length < kImuSampleBodyBytes) {
+      problem(start, "IMU sample record of " + std::to_string(length) + " bytes (an IMU sample body has " +
+                         std::to_string(kImuSampleBodyBytes) + ")");
+      return false;
+    }
     offset_ += expected;
     ++stats_.records;
     stats_.bytes += expected;
-    if (type == RecordType::Sample) {
-      // Longer sample bodies are a later version's additions: the first 96 bytes are as here.
-      out = decode_sample_body(body_.data() + 1);
+    if (type == RecordType::Sample || type == RecordType::ImuSample) {
+      // Longer bodies are a later version's additions: the first 96 (168) bytes are as here.
+      out = type == RecordType::Sample ? decode_sample_body(body_.data() + 1) : decode_imu_sample_body(body_.data() + 1);
       ++stats_.samples;
       if (header_.find(out.stream_id) == nullptr) ++stats_.unknown_stream_samples;
       return true;

@@ -123,9 +123,20 @@ std::vector<unsigned char> encode_sample_log_header(const SampleLogHeader& heade
   return out;
 }
 
-void encode_sample_record(const Sample& s, unsigned char* out) {
-  put_u32(out, static_cast<std::uint32_t>(kSampleBodyBytes));
-  out[4] = static_cast<unsigned char>(RecordType::Sample);
+RecordType sample_record_type(const Sample& s) {
+  return (s.flags & (kHasGyro | kHasAccel | kHasMag | kNoOrientation)) != 0 ? RecordType::ImuSample
+                                                                              : RecordType::Sample;
+}
+
+std::size_t sample_record_bytes(const Sample& s) {
+  return sample_record_type(s) == RecordType::ImuSample ? kImuSampleRecordBytes : kSampleRecordBytes;
+}
+
+std::size_t encode_sample_record(const Sample& s, unsigned char* out) {
+  const RecordType type = sample_record_type(s);
+  const std::size_t body = type == RecordType::ImuSample ? kImuSampleBodyBytes : kSampleBodyBytes;
+  put_u32(out, static_cast<std::uint32_t>(body));
+  out[4] = static_cast<unsigned char>(type);
   unsigned char* b = out + 5;
   put_u32(b + 0, s.stream_id);
   put_u64(b + 4, s.sequence);
@@ -140,7 +151,13 @@ void encode_sample_record(const Sample& s, unsigned char* out) {
   put_f64(b + 72, s.position.x());
   put_f64(b + 80, s.position.y());
   put_f64(b + 88, s.position.z());
-  put_u32(b + kSampleBodyBytes, detail::crc32(out + 4, 1 + kSampleBodyBytes));
+  if (type == RecordType::ImuSample) {
+    unsigned char* p = b + kSampleBodyBytes;
+    for (const Vec3* v : {&s.gyro, &s.accel, &s.mag})
+      for (int k = 0; k < 3; ++k, p += 8) put_f64(p, (*v)[k]);
+  }
+  put_u32(b + body, detail::crc32(out + 4, 1 + body));
+  return kRecordOverheadBytes + body;
 }
 
 std::filesystem::path sample_log_part_path(const std::filesystem::path& first, std::uint64_t index) {
@@ -313,15 +330,15 @@ bool SampleLogWriter::append(const Sample& sample) {
     ++stats_.samples_dropped;
     return false;
   }
-  if (used_ + kSampleRecordBytes > options_.buffer_bytes) {
+  const std::size_t bytes = sample_record_bytes(sample);
+  if (used_ + bytes > options_.buffer_bytes) {
     if (!failing_) flush();
-    if (used_ + kSampleRecordBytes > options_.buffer_bytes) {
+    if (used_ + bytes > options_.buffer_bytes) {
       ++stats_.samples_dropped;
       return false;
     }
   }
-  encode_sample_record(sample, buffer_.get() + used_);
-  used_ += kSampleRecordBytes;
+  used_ += encode_sample_record(sample, buffer_.get() + used_);
   ++buffered_samples_;
   ++stats_.samples_appended;
   if (!failing_ && used_ > options_.flush_bytes) flush();
@@ -350,7 +367,7 @@ bool SampleLogWriter::flush() {
       const bool fits = (end - pos) + size <= room;
       const bool alone = end == pos && file_bytes_ == header_bytes_.size();  // an empty file takes
       if (!fits && !alone) break;                                             // one record, any size
-      if (buffer_[end + 4] == static_cast<unsigned char>(RecordType::Sample)) ++samples;
+      ++samples;  // the buffer holds sample records only
       end += size;
       if (!fits) break;
     }

@@ -26,6 +26,7 @@
 #include "posefair/daemon/config.hpp"
 #include "posefair/daemon/pipeline.hpp"
 #include "posefair/daemon/udp_socket.hpp"
+#include "posefair/formats/sample_log.hpp"
 
 #include "../support/counting_allocator.hpp"
 #include "../support/test_files.hpp"
@@ -154,6 +155,38 @@ TEST_F(PipelineAllocation, ReplayToABinaryOutputAllocatesNothingOnTheRealtimeThr
   EXPECT_EQ(run.stats.published, kDemoSamples);
   EXPECT_EQ(run.stats.send_failures, 0u);
   EXPECT_GT(run.datagrams, 0u);
+}
+
+// A raw IMU stream (every other sample raw-only, the rest orientations with their readings):
+// the engine's raw-only path, which counts and skips, allocates nothing either.
+TEST_F(PipelineAllocation, RawOnlySamplesAllocateNothingOnTheRealtimeThreads) {
+  testing::ScratchDir dir;
+  {
+    formats::SampleLogHeader h;
+    h.streams = {{1, "imu", "test"}};
+    formats::SampleLogWriterOptions o;
+    o.sync = false;
+    formats::SampleLogWriter w(dir / "raw.pflog", h, o);
+    for (std::uint64_t i = 0; i < 1000; ++i) {
+      Sample s;
+      s.stream_id = 1;
+      s.sequence = i;
+      s.time = 0.005 * static_cast<double>(i);
+      s.flags = (i % 2 ? kNoOrientation : 0u) | kHasGyro | kHasAccel;
+      s.gyro = Vec3(0, 0, 0.5);
+      s.accel = Vec3(0, 0, 9.81);
+      w.append(s);
+    }
+  }
+  const PipelineRun run =
+      run_pipeline("type = \"replay\"\npath = \"" + (dir / "raw.pflog").string() + "\"\ntiming = \"fast\"\n", "linear", "binary");
+  SCOPED_TRACE(describe(run));
+  EXPECT_TRUE(run.ended);
+  ASSERT_EQ(run.threads, 2);
+  for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
+  EXPECT_EQ(run.stats.received, 1000u);
+  EXPECT_EQ(run.stats.raw_unfused, 500u);
+  EXPECT_EQ(run.stats.published, 500u);
 }
 
 TEST_F(PipelineAllocation, GaussNewtonOnASyntheticStreamAllocatesNothingOnTheRealtimeThreads) {

@@ -24,12 +24,15 @@
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
 #include "posefair/formats/pose_file.hpp"
+#include "posefair/formats/sample_log.hpp"
+#include "../support/test_files.hpp"
 #include "../support/udp_collector.hpp"
 
 namespace posefair::daemon {
 namespace {
 
 using namespace std::chrono_literals;
+using testing::ScratchDir;
 using testing::UdpCollector;
 using testing::wait_until;
 
@@ -371,6 +374,78 @@ TEST(Pipeline, MulticastOutputReachesAGroupMember) {
     ++got;
   }
   EXPECT_EQ(got, published);
+}
+
+// A raw IMU stream without a fusion stage: a recording of 300 samples at 100 Hz in which every
+// third is raw-only (kNoOrientation: its quaternion a placeholder) and the others are
+// orientations, half of them with their gyroscope and accelerometer. The raw-only samples never
+// reach the engine: they are counted as raw_unfused (not rejected, not out of order), every
+// orientation is faired and published as before, and the recorder keeps all 300 with their
+// readings.
+TEST(Pipeline, RawOnlySamplesAreCountedNotFairedAndRecordedWithTheirReadings) {
+  ScratchDir dir;
+  std::vector<Sample> recorded(300);
+  for (std::size_t i = 0; i < recorded.size(); ++i) {
+    Sample& s = recorded[i];
+    s.stream_id = 1;
+    s.sequence = i;
+    s.time = 10.0 + 0.01 * static_cast<double>(i);
+    s.orientation = Quat(Eigen::AngleAxisd(0.01 * static_cast<double>(i), Vec3::UnitZ()));
+    if (i % 3 == 2) {
+      s.flags = kNoOrientation | kHasGyro | kHasAccel;
+      s.orientation = Quat(0, 0, 0, 0);  // what an engine must never see: not even a rotation
+    } else if (i % 2 == 0) {
+      s.flags = kHasGyro | kHasAccel;
+    }
+    s.gyro = s.flags ? Vec3(0, 0, 1.0) : Vec3::Zero();
+    s.accel = s.flags ? Vec3(0.1, 0, 9.81) : Vec3::Zero();
+  }
+  {
+    formats::SampleLogHeader h;
+    h.streams = {{1, "imu", "test"}};
+    formats::SampleLogWriterOptions o;
+    o.sync = false;
+    formats::SampleLogWriter w(dir / "in.pflog", h, o);
+    for (const Sample& s : recorded) ASSERT_TRUE(w.append(s));
+  }
+  UdpCollector receiver;
+  const std::string text = "[[stream]]\nid = 1\nname = \"imu\"\n[stream.driver]\ntype = \"replay\"\npath = \"" +
+                           (dir / "in.pflog").string() +
+                           "\"\ntiming = \"fast\"\n[stream.engine]\norder = 3\nwindow = 16\nlag = 0\n\n"
+                           "[recorder]\npath = \"" + (dir / "out.pflog").string() + "\"\nsync = false\n\n"
+                           "[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(receiver.port()) + "\"]\n";
+  const DaemonConfig config = parse_config(text, "/virtual/raw.toml");
+  StreamStats s;
+  {
+    Pipeline pipeline(config, kSession, {}, false, {});
+    pipeline.start();
+    ASSERT_TRUE(wait_until([&] { return pipeline.sources_ended(); }, 30s));
+    pipeline.stop();
+    s = pipeline.stats().at(0);
+  }
+  EXPECT_EQ(s.received, 300u);
+  EXPECT_EQ(s.raw_unfused, 100u);
+  EXPECT_EQ(s.rejected + s.out_of_order + s.ring_dropped, 0u);
+  EXPECT_EQ(s.emitted, 200u);
+  EXPECT_EQ(s.published, 200u);
+  receiver.drain();
+  const std::vector<PoseMessage> got = receiver.messages();
+  ASSERT_EQ(got.size(), 200u);
+  for (std::size_t k = 0; k < got.size(); ++k) {
+    const std::size_t i = k + k / 2;  // the k-th orientation sample of the recording
+    ASSERT_EQ(got[k].sample_time, recorded[i].time) << k;
+  }
+
+  const formats::SampleLogContents out = formats::read_sample_log(dir / "out.pflog");
+  EXPECT_EQ(s.recorded, 300u);
+  ASSERT_EQ(out.samples.size(), 300u);
+  for (std::size_t i = 0; i < out.samples.size(); ++i) {
+    const Sample& o = out.samples[i];
+    EXPECT_EQ(o.flags, recorded[i].flags) << i;
+    EXPECT_EQ(o.gyro, recorded[i].gyro) << i;
+    EXPECT_EQ(o.accel, recorded[i].accel) << i;
+    EXPECT_EQ(o.orientation.coeffs(), recorded[i].orientation.coeffs()) << i;
+  }
 }
 
 }  // namespace

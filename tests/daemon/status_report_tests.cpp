@@ -42,6 +42,20 @@ TEST(StatusReport, CounterLineWithoutDeviceHasNoDevicePart) {
   EXPECT_EQ(lines[0].find("device"), std::string::npos) << lines[0];
 }
 
+// Raw-only samples that no fusion stage turned into orientations show in both texts with their
+// reason, and only when there are some.
+TEST(StatusReport, RawOnlySamplesShowWithTheirReason) {
+  StreamStats s = stream(1, "imu", 0);
+  EXPECT_EQ(counter_lines({s}, {}, 0.0)[0].find("raw-only"), std::string::npos);
+  EXPECT_EQ(status_line({s}, {}, 1.0).find("raw-only"), std::string::npos);
+  s.received = 500;
+  s.raw_unfused = 500;
+  const auto lines = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(lines[0].find(", raw-only 500 (not faired: no orientation, no fusion stage)"), std::string::npos) << lines[0];
+  EXPECT_NE(status_line({s}, {}, 1.0).find("imu 0.0/s drop 0 p99 0us raw-only 500 unfused"), std::string::npos)
+      << status_line({s}, {}, 1.0);
+}
+
 TEST(StatusReport, CounterLineAndStatusCarryTheEngineAdaptation) {
   StreamStats s = stream(1, "head", 2000);
   const auto unknown = counter_lines({s}, {}, 0.0);

@@ -133,6 +133,89 @@ TEST(SampleLog, TheDocumentedExamplesAreWhatTheEncoderWrites) {
   EXPECT_EQ(r, expected);
 }
 
+// docs/recording.md, the IMU sample example (type 2): stream 7, sequence 43, time 2, receive
+// time 1235, flags kHasGyro | kHasAccel | kNoOrientation, gyro (0.5, -0.25, 0.125), accel
+// (0, 0, 9.8125). Bytes computed for the document independently of the encoder.
+TEST(SampleLog, TheDocumentedImuSampleIsWhatTheEncoderWrites) {
+  Sample s;
+  s.stream_id = 7;
+  s.sequence = 43;
+  s.time = 2.0;
+  s.receive_time = 1235.0;
+  s.flags = kHasGyro | kHasAccel | kNoOrientation;
+  s.gyro = Vec3(0.5, -0.25, 0.125);
+  s.accel = Vec3(0, 0, 9.8125);
+  std::vector<unsigned char> expected(kImuSampleRecordBytes, 0);
+  const std::pair<std::size_t, std::vector<unsigned char>> nonzero[] = {
+      {0x00, {0xa8}}, {0x04, {0x02, 0x07}}, {0x09, {0x2b}}, {0x18, {0x40}}, {0x26, {0x4c, 0x93, 0x40, 0xb0}},
+      {0x33, {0xf0, 0x3f}}, {0x6b, {0xe0, 0x3f}}, {0x73, {0xd0, 0xbf}}, {0x7b, {0xc0, 0x3f}},
+      {0x92, {0xa0, 0x23, 0x40}}, {0xad, {0x97, 0x76, 0x2f, 0x51}}};
+  for (const auto& [at, bytes] : nonzero) std::copy(bytes.begin(), bytes.end(), expected.begin() + static_cast<std::ptrdiff_t>(at));
+  EXPECT_EQ(sample_record_type(s), RecordType::ImuSample);
+  EXPECT_EQ(sample_record_bytes(s), 177u);
+  std::vector<unsigned char> r(kImuSampleRecordBytes);
+  EXPECT_EQ(encode_sample_record(s, r.data()), 177u);
+  EXPECT_EQ(r, expected);
+  EXPECT_TRUE(bit_identical(decode_imu_sample_body(r.data() + 5), s));
+  // Without readings (and with an orientation) a sample is the 105-byte type 1 record as before.
+  s.flags = kHasDeviceTime;
+  EXPECT_EQ(sample_record_type(s), RecordType::Sample);
+  EXPECT_EQ(encode_sample_record(s, r.data()), kSampleRecordBytes);
+}
+
+// A log written before IMU sample records existed (the documented header and sample example,
+// the bytes an old writer wrote) reads as it always did; and an IMU sample record with a longer
+// body (a later version's additions) reads its first 168 bytes, one with a shorter body stops
+// the read with a problem.
+TEST(SampleLog, OldLogsReadAndImuRecordBodiesAreChecked) {
+  ScratchDir dir;
+  const std::vector<unsigned char> old_log = {
+      0x50, 0x46, 0x4c, 0x4f, 0x47, 0x00, 0x00, 0x01, 0x01, 0x00, 0x21, 0x00, 0x01, 0x00, 0x07, 0x00, 0x00,
+      0x00, 0x04, 0x00, 0x68, 0x65, 0x61, 0x64, 0x03, 0x00, 0x69, 0x6d, 0x75, 0x59, 0x44, 0xa7, 0x4a, 0x60,
+      0x00, 0x00, 0x00, 0x01, 0x07, 0x00, 0x00, 0x00, 0x2a, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+      0x00, 0x00, 0x00, 0x00, 0x00, 0xf8, 0x3f, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+      0x00, 0x00, 0x00, 0x4a, 0x93, 0x40, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xf0,
+      0x3f, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+      0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xd0, 0x3f, 0x00,
+      0x00, 0x00, 0x00, 0x00, 0x00, 0xf0, 0xbf, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x40, 0x1e, 0x04,
+      0x9e, 0xe0};  // docs/recording.md's header and sample record examples
+  spit(dir / "old.pflog", old_log);
+  const SampleLogContents old = read_sample_log(dir / "old.pflog");
+  ASSERT_EQ(old.samples.size(), 1u);
+  EXPECT_TRUE(old.stats.problems.empty());
+  EXPECT_EQ(old.samples[0].flags, std::uint32_t{kHasPosition});
+  EXPECT_EQ(old.samples[0].position, Vec3(0.25, -1.0, 2.0));
+  EXPECT_EQ(old.samples[0].gyro, Vec3::Zero());
+
+  Sample imu = make_samples(1)[0];
+  imu.flags |= kHasMag;
+  imu.mag = Vec3(1, 2, 3);
+  std::vector<unsigned char> rec(kImuSampleRecordBytes);
+  encode_sample_record(imu, rec.data());
+  const auto with_body = [&](std::size_t body) {  // the record with its body cut or padded, CRC redone
+    std::vector<unsigned char> r(rec.begin(), rec.begin() + 5 + static_cast<std::ptrdiff_t>(std::min(body, kImuSampleBodyBytes)));
+    r.resize(5 + body, 0xEE);
+    detail::put_u32(r.data(), static_cast<std::uint32_t>(body));
+    r.resize(r.size() + 4);
+    detail::put_u32(r.data() + 5 + body, detail::crc32(r.data() + 4, 1 + body));
+    return r;
+  };
+  std::vector<unsigned char> longer = old_log;
+  for (unsigned char b : with_body(kImuSampleBodyBytes + 16)) longer.push_back(b);
+  spit(dir / "longer.pflog", longer);
+  const SampleLogContents l = read_sample_log(dir / "longer.pflog");
+  ASSERT_EQ(l.samples.size(), 2u);
+  EXPECT_TRUE(bit_identical(l.samples[1], imu));
+  std::vector<unsigned char> shorter = old_log;
+  for (unsigned char b : with_body(kSampleBodyBytes)) shorter.push_back(b);
+  spit(dir / "shorter.pflog", shorter);
+  const SampleLogContents sh = read_sample_log(dir / "shorter.pflog");
+  EXPECT_EQ(sh.samples.size(), 1u);
+  ASSERT_EQ(sh.stats.problems.size(), 1u);
+  EXPECT_NE(sh.stats.problems[0].message.find("IMU sample record of 96 bytes (an IMU sample body has 168)"), std::string::npos)
+      << sh.stats.problems[0].message;
+}
+
 TEST(SampleLog, RoundTripIsBitIdentical) {
   ScratchDir dir;
   std::vector<Sample> samples = make_samples(1000);
@@ -145,9 +228,16 @@ TEST(SampleLog, RoundTripIsBitIdentical) {
   samples[8].sequence = std::numeric_limits<std::uint64_t>::max();
   samples[9].flags = 0xFFFF'FFFFu;  // unknown bits too
   samples[10].stream_id = 99;       // not in the stream table: kept, counted
+  samples[9].gyro = Vec3(1, 2, 3);  // (its flags say it has every reading: an IMU sample record)
+  samples[11].flags |= kHasGyro | kHasAccel | kHasMag;
+  samples[11].gyro = Vec3(-0.0, std::bit_cast<double>(0x7ff8dead'beef0002ull), 1e-300);
+  samples[11].accel = Vec3(0.1, 0.2, 9.81);
+  samples[11].mag = Vec3(20, -5, -40);
+  samples[12].flags |= kNoOrientation | kHasAccel;  // raw-only
+  samples[12].accel = Vec3(0, 0, 9.81);
   const fs::path path = dir / "run.pflog";
   const std::vector<unsigned char> bytes = write_log(path, samples);
-  EXPECT_EQ(bytes.size(), header_size() + samples.size() * kSampleRecordBytes);
+  EXPECT_EQ(bytes.size(), header_size() + (samples.size() - 3) * kSampleRecordBytes + 3 * kImuSampleRecordBytes);
 
   const SampleLogContents log = read_sample_log(path);
   EXPECT_EQ(log.header, three_streams());

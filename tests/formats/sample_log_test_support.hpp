@@ -60,13 +60,17 @@ inline std::uint64_t bits(double v) { return std::bit_cast<std::uint64_t>(v); }
 // Every field equal bit for bit (NaN payloads and the sign of zero included).
 inline ::testing::AssertionResult bit_identical(const Sample& a, const Sample& b) {
   const double av[] = {a.time, a.device_time, a.receive_time, a.orientation.w(), a.orientation.x(),
-                       a.orientation.y(), a.orientation.z(), a.position.x(), a.position.y(), a.position.z()};
+                       a.orientation.y(), a.orientation.z(), a.position.x(), a.position.y(), a.position.z(),
+                       a.gyro.x(), a.gyro.y(), a.gyro.z(), a.accel.x(), a.accel.y(), a.accel.z(),
+                       a.mag.x(), a.mag.y(), a.mag.z()};
   const double bv[] = {b.time, b.device_time, b.receive_time, b.orientation.w(), b.orientation.x(),
-                       b.orientation.y(), b.orientation.z(), b.position.x(), b.position.y(), b.position.z()};
+                       b.orientation.y(), b.orientation.z(), b.position.x(), b.position.y(), b.position.z(),
+                       b.gyro.x(), b.gyro.y(), b.gyro.z(), b.accel.x(), b.accel.y(), b.accel.z(),
+                       b.mag.x(), b.mag.y(), b.mag.z()};
   if (a.stream_id != b.stream_id) return ::testing::AssertionFailure() << "stream_id " << a.stream_id << " vs " << b.stream_id;
   if (a.sequence != b.sequence) return ::testing::AssertionFailure() << "sequence " << a.sequence << " vs " << b.sequence;
   if (a.flags != b.flags) return ::testing::AssertionFailure() << "flags " << a.flags << " vs " << b.flags;
-  for (int i = 0; i < 10; ++i) {
+  for (std::size_t i = 0; i < std::size(av); ++i) {
     if (bits(av[i]) != bits(bv[i])) {
       return ::testing::AssertionFailure() << "value " << i << ": " << av[i] << " vs " << bv[i];
     }

@@ -1,6 +1,6 @@
 // Fuzz target: the BNO08x UART-RVC decoder. Any bytes, fed whole and fed split in two at a point
 // taken from the data, must give the same samples and counters, every sample a finite unit
-// quaternion with a non-decreasing frame counter, and no crash, exception or out-of-bounds read.
+// quaternion with its acceleration and a non-decreasing frame counter, and no crash, exception or out-of-bounds read.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -16,7 +16,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (std::size_t i = 0; i < whole.samples.size(); ++i) {
     const auto& s = whole.samples[i];
     if (!posefair::testing::finite_unit(s.orientation, 1e-9)) std::abort();
-    if (s.flags != 0 || !s.has_frame_counter) std::abort();
+    if (s.flags != posefair::kHasAccel || !s.has_frame_counter) std::abort();
     if (i > 0 && s.frame_counter < whole.samples[i - 1].frame_counter) std::abort();
   }
   return 0;

@@ -3,8 +3,11 @@
 // a serial line shows in practice. Deterministic: the same source and seeds give the same bytes.
 //
 //   make_replay_logs <source.csv> <output directory>
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -36,7 +39,41 @@ struct Motion {
   double t;  // s since the first frame
   Quat q;
   Vec3 p;
+  Vec3 gyro;   // rad/s, sensor axes: the excerpt's gyroscope columns
+  Vec3 accel;  // m/s², sensor axes: gravity's specific force seen at orientation q (no linear acceleration)
 };
+
+// The gyr_x_rads, gyr_y_rads, gyr_z_rads columns of the excerpt, row by row (the pose reader
+// takes the quaternion and position columns only).
+std::vector<Vec3> read_gyro_columns(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  for (std::size_t at = 0; at <= line.size();) {
+    const std::size_t comma = std::min(line.find(',', at), line.size());
+    names.push_back(line.substr(at, comma - at));
+    at = comma + 1;
+  }
+  std::array<std::size_t, 3> column{};
+  for (int k = 0; k < 3; ++k) {
+    const std::string want = std::string("gyr_") + "xyz"[k] + "_rads";
+    const auto it = std::find(names.begin(), names.end(), want);
+    if (it == names.end()) throw std::runtime_error(path + ": no column " + want);
+    column[static_cast<std::size_t>(k)] = static_cast<std::size_t>(it - names.begin());
+  }
+  std::vector<Vec3> out;
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    for (std::size_t at = 0; at <= line.size();) {
+      const std::size_t comma = std::min(line.find(',', at), line.size());
+      v.push_back(std::strtod(line.c_str() + at, nullptr));
+      at = comma + 1;
+    }
+    out.emplace_back(v.at(column[0]), v.at(column[1]), v.at(column[2]));
+  }
+  return out;
+}
 
 template <typename Bytes>
 std::string text(const Bytes& b) {
@@ -157,11 +194,14 @@ int main(int argc, char** argv) {
     posefair::formats::ReadOptions ro;
     ro.csv_prefix = "gt_";
     const posefair::PoseSequence seq = posefair::formats::read_pose_file(argv[1], ro).poses();
+    const std::vector<Vec3> gyro = read_gyro_columns(argv[1]);
     std::vector<Motion> motion;
     for (std::size_t i = 0; i < kFrames; ++i) {
       const std::size_t k = i * kStride;
-      if (k >= seq.size()) throw std::runtime_error("the source has too few samples");
-      motion.push_back({seq.time[k] - seq.time[0], seq.orientation[k], seq.has_position() ? seq.position[k] : Vec3::Zero()});
+      if (k >= seq.size() || k >= gyro.size()) throw std::runtime_error("the source has too few samples");
+      const Quat& q = seq.orientation[k];
+      motion.push_back({seq.time[k] - seq.time[0], q, seq.has_position() ? seq.position[k] : Vec3::Zero(), gyro[k],
+                        q.conjugate() * Vec3(0.0, 0.0, 9.81)});  // ENU: +g up at rest
     }
     const auto us = [](double t, double start) {  // a µs device clock that wraps at 2^32
       return static_cast<std::uint32_t>(static_cast<std::uint64_t>(std::llround(start + t * 1e6)) & 0xFFFFFFFFu);
@@ -199,6 +239,16 @@ int main(int argc, char** argv) {
          [&](std::size_t, const Motion& m) { return drv::encode_posefair_sentence(us(m.t, near_wrap), m.q, &m.p); }},
         {"posefair-binary", "a posefair microcontroller tracker, binary frames with position", "posefair", 921600, 17,
          [&](std::size_t, const Motion& m) { return text(drv::encode_posefair_frame(us(m.t, near_wrap), m.q, &m.p)); }},
+        {"posefair-imu",
+         "a posefair microcontroller tracker with an IMU: binary frames with quaternion, gyroscope and accelerometer, "
+         "every 5th raw-only, and $PFI sentences (gyroscope: the excerpt's gyr columns; accelerometer: gravity at the "
+         "orientation)",
+         "posefair", 921600, 18,
+         [&](std::size_t i, const Motion& m) {
+           const drv::PosefairImuReading imu{m.gyro, m.accel};
+           if (i % 7 == 3) return drv::encode_posefair_imu_sentence(us(m.t, near_wrap), m.gyro, m.accel, nullptr);
+           return text(drv::encode_posefair_frame(us(m.t, near_wrap), i % 5 == 4 ? nullptr : &m.q, nullptr, &imu, nullptr));
+         }},
     };
     for (const Device& d : devices) write_log(d, motion, "data/demo/broad-07-excerpt.csv", argv[2]);
   } catch (const std::exception& e) {

@@ -49,7 +49,7 @@ class CollectingSink final : public drv::SampleSink {
 std::string render(const std::string& log_name, const std::string& protocol, const std::vector<posefair::Sample>& samples,
                    const drv::DecoderCounters& c) {
   std::string out = "# " + log_name + " through a pseudo-terminal into SerialDriver, protocol " + protocol + "\n";
-  out += "# sequence device_time_s qw qx qy qz [px py pz]\n";
+  out += "# sequence device_time_s qw qx qy qz [px py pz] [g gx gy gz] [a ax ay az] [m mx my mz]\n";
   char buf[256];
   for (const posefair::Sample& s : samples) {
     const posefair::Quat& q = s.orientation;
@@ -58,13 +58,20 @@ std::string render(const std::string& log_name, const std::string& protocol, con
       std::snprintf(buf, sizeof buf, "%.6f", s.device_time);
       device_time = buf;
     }
-    std::snprintf(buf, sizeof buf, "%" PRIu64 " %s %.8f %.8f %.8f %.8f", s.sequence, device_time.c_str(), q.w(), q.x(),
-                  q.y(), q.z());
+    if (s.has_orientation())
+      std::snprintf(buf, sizeof buf, "%" PRIu64 " %s %.8f %.8f %.8f %.8f", s.sequence, device_time.c_str(), q.w(),
+                    q.x(), q.y(), q.z());
+    else  // a raw-only sample: its quaternion is not a measurement
+      std::snprintf(buf, sizeof buf, "%" PRIu64 " %s - - - -", s.sequence, device_time.c_str());
     out += buf;
-    if (s.has_position()) {
-      std::snprintf(buf, sizeof buf, " %.6f %.6f %.6f", s.position.x(), s.position.y(), s.position.z());
+    const auto vector = [&](const char* tag, const posefair::Vec3& v) {
+      std::snprintf(buf, sizeof buf, "%s%.6f %.6f %.6f", tag, v.x(), v.y(), v.z());
       out += buf;
-    }
+    };
+    if (s.has_position()) vector(" ", s.position);
+    if (s.has_gyro()) vector(" g ", s.gyro);
+    if (s.has_accel()) vector(" a ", s.accel);
+    if (s.has_mag()) vector(" m ", s.mag);
     out += "\n";
   }
   std::snprintf(buf, sizeof buf,

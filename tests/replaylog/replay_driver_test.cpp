@@ -8,6 +8,8 @@
 #include <condition_variable>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
@@ -15,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "posefair/drivers/decoder.hpp"
 #include "posefair/drivers/replay_driver.hpp"
 #include "posefair/formats/sample_log.hpp"
 #include "../formats/sample_log_test_support.hpp"
@@ -112,6 +115,49 @@ TEST(ReplayDriver, AsFastAsPossibleDeliversEverySampleInOrderLikeADevice) {
   EXPECT_EQ(driver.delivered(), recorded.size());
   EXPECT_EQ(driver.dropped(), 0u);
   EXPECT_EQ(driver.rounds_completed(), 1u);
+}
+
+// The golden WitMotion log (tests/replay/witmotion-wt901.log: time, acceleration and quaternion
+// packets, some quaternions damaged) decoded, recorded and replayed: every sample comes back
+// with its raw readings, the raw-only ones (a lost quaternion's acceleration) included.
+TEST(ReplayDriver, RawReadingsOfARecordedDeviceReplayIntact) {
+  std::ifstream in(std::string(POSEFAIR_SOURCE_DIR) + "/tests/replay/witmotion-wt901.log", std::ios::binary);
+  const std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t data = all.find("# data:\n");
+  ASSERT_NE(data, std::string::npos);
+  struct Recorder final : DecodedSink {
+    std::vector<Sample> samples;
+    void on_sample(const DecodedSample& d) override {
+      Sample s;
+      s.stream_id = 10;
+      s.sequence = samples.size();
+      s.time = 0.01 * static_cast<double>(samples.size());
+      fill_sample(d, s);
+      samples.push_back(s);
+    }
+  } recorder;
+  const std::string bytes = all.substr(data + 8);
+  make_decoder("witmotion")->feed({reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()}, recorder);
+  const std::vector<Sample>& recorded = recorder.samples;
+  std::size_t with_accel = 0, raw_only = 0;
+  for (const Sample& s : recorded) {
+    with_accel += s.has_accel() && s.has_orientation();
+    raw_only += !s.has_orientation();
+  }
+  EXPECT_EQ(with_accel, 293u);  // as its .chk: 297 orientations, 4 of them lost their acceleration packet,
+  EXPECT_EQ(raw_only, 4u);      // and 4 accelerations lost their quaternion
+
+  ScratchDir dir;
+  write_log(dir / "wit.pflog", recorded);
+  ReplayDriver driver(dir / "wit.pflog", fast());
+  CollectingSink sink;
+  driver.run(std::stop_token{}, sink);
+  ASSERT_EQ(sink.samples.size(), recorded.size());
+  for (std::size_t i = 0; i < recorded.size(); ++i) {
+    Sample expected = recorded[i];
+    expected.receive_time = sink.samples[i].receive_time;
+    ASSERT_TRUE(bit_identical(sink.samples[i], expected)) << i;
+  }
 }
 
 TEST(ReplayDriver, OriginalTimingFollowsTheRecordingAtTheGivenSpeed) {

@@ -59,8 +59,8 @@ inline std::vector<std::size_t> chunks_cut_at(const std::vector<std::size_t>& cu
 
 // Every field of the two samples equal, bit for bit.
 inline bool same(const drivers::DecodedSample& a, const drivers::DecodedSample& b) {
-  return a.orientation.coeffs() == b.orientation.coeffs() && a.position == b.position && a.flags == b.flags &&
-         a.device_time == b.device_time && a.frame_counter == b.frame_counter &&
+  return a.orientation.coeffs() == b.orientation.coeffs() && a.position == b.position && a.gyro == b.gyro &&
+         a.accel == b.accel && a.mag == b.mag && a.flags == b.flags && a.device_time == b.device_time && a.frame_counter == b.frame_counter &&
          a.has_frame_counter == b.has_frame_counter;
 }
 

@@ -76,7 +76,8 @@ TEST(Bno08xRvcDecoder, DatasheetExample) {
   const DecodedSample& s = r.samples[0];
   EXPECT_TRUE(s.has_frame_counter);
   EXPECT_EQ(s.frame_counter, 222u);
-  EXPECT_EQ(s.flags, 0u);  // no device time, no position
+  EXPECT_EQ(s.flags, kHasAccel);  // no device time, no position; the acceleration, in m/s²
+  EXPECT_NEAR((s.accel - Vec3(-371, -20, 977) * 9.80665e-3).norm(), 0, 1e-12);
   EXPECT_LT(so3::rotation_angle(s.orientation, zyx(0.01, -1.10, 20.85)), 1e-12);
   DecoderCounters want;
   want.bytes = kFrame;

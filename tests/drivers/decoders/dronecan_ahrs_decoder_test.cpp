@@ -120,7 +120,8 @@ TEST(DroneCanAhrs, HandFramedTransferDecodes) {
   const CanDecoded r = decode(frames);
   ASSERT_EQ(r.samples.size(), 1u);
   EXPECT_EQ(r.samples[0].orientation.coeffs(), Quat::Identity().coeffs());
-  EXPECT_EQ(r.samples[0].flags, std::uint32_t{kHasDeviceTime});
+  EXPECT_EQ(r.samples[0].flags, std::uint32_t{kHasDeviceTime | kHasGyro});
+  EXPECT_EQ(r.samples[0].gyro, Vec3(0.125, -0.25, 0.5));  // the angular velocity rides along
   EXPECT_DOUBLE_EQ(r.samples[0].device_time, 123.456789);
   EXPECT_EQ(r.samples[0].frame_counter, 7u);
   EXPECT_EQ(r.counters.frames, 1u);
@@ -159,6 +160,7 @@ TEST(DroneCanAhrs, RoundTripsWithEveryCovarianceLayout) {
     EXPECT_NEAR(s.orientation.norm(), 1.0, 1e-15);
     EXPECT_EQ(s.frame_counter, i);  // transfer ids unwrapped past 31
     EXPECT_DOUBLE_EQ(s.device_time, 1e-3 * static_cast<double>(i + 1));
+    EXPECT_EQ(s.gyro, Vec3(0.125, -0.25, 0.5)) << i;  // found behind every covariance length
   }
 }
 

@@ -71,6 +71,78 @@ TEST(PosefairCanDecoder, EncoderWritesTheDocumentExample) {
   }
 }
 
+// docs/can-protocol.md, "Raw IMU example": seq 0x2B, time 1244567 µs, gyroscope (0.5, -0.25,
+// 0.125) rad/s, accelerometer (0.5, -1, 9.81) m/s², magnetometer (20, -5, -40) µT.
+const std::vector<CanFrame> kRawExample = {
+    frame(0x200, "2B 97 FD 12 00"),
+    frame(0x203, "2B 00 F4 01 06 FF 7D 00"),
+    frame(0x203, "2B 01 32 00 9C FF D5 03"),
+    frame(0x203, "2B 82 D0 07 0C FE 60 F0"),
+};
+
+TEST(PosefairCanDecoder, RawImuDocumentExample) {
+  const CanDecoded r = decode(kRawExample);
+  ASSERT_EQ(r.samples.size(), 1u);
+  const DecodedSample& s = r.samples[0];
+  EXPECT_EQ(s.flags, kNoOrientation | kHasDeviceTime | kHasGyro | kHasAccel | kHasMag);
+  EXPECT_DOUBLE_EQ(s.device_time, 1.244567);
+  EXPECT_NEAR((s.gyro - Vec3(0.5, -0.25, 0.125)).norm(), 0, 1e-12);
+  EXPECT_NEAR((s.accel - Vec3(0.5, -1, 9.81)).norm(), 0, 1e-12);
+  EXPECT_NEAR((s.mag - Vec3(20, -5, -40)).norm(), 0, 1e-12);
+  EXPECT_EQ(s.frame_counter, 0x2Bu);
+  EXPECT_EQ(r.counters.frames, 4u);
+  EXPECT_EQ(r.counters.resyncs, 0u);  // the TIME frame was taken by the raw set, not dropped
+  EXPECT_EQ(r.counters.skipped_bytes, 0u);
+
+  const Vec3 g(0.5, -0.25, 0.125), a(0.5, -1, 9.81), m(20, -5, -40);
+  std::vector<CanFrame> enc = encode_posefair_can_raw(0x200, false, &g, &a, &m, 0x2B);
+  ASSERT_EQ(enc.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(enc[k].can_id, kRawExample[k + 1].can_id) << k;
+    EXPECT_TRUE(std::equal(enc[k].data.begin(), enc[k].data.begin() + 8, kRawExample[k + 1].data.begin())) << k;
+  }
+}
+
+// A tracker that sends its quaternion and its readings each period: the quaternion completes
+// its sample with the time; the RAW set after it is a raw-only sample with the same time.
+TEST(PosefairCanDecoder, RawSetAfterTheQuaternionTakesItsTime) {
+  std::vector<CanFrame> stream;
+  const Vec3 g(0.01, 0, 0), a(0, 0, 9.81);
+  for (std::uint8_t k = 0; k < 3; ++k) {
+    const auto q = encode_posefair_can(0x200, false, Quat::Identity(), 1000u * k, nullptr, k);
+    const auto raw = encode_posefair_can_raw(0x200, false, &g, &a, nullptr, k);
+    stream.insert(stream.end(), q.begin(), q.end());
+    stream.insert(stream.end(), raw.begin(), raw.end());
+  }
+  const CanDecoded r = decode(stream);
+  ASSERT_EQ(r.samples.size(), 6u);
+  for (std::size_t k = 0; k < 6; k += 2) {
+    EXPECT_EQ(r.samples[k].flags, kHasDeviceTime) << k;
+    EXPECT_EQ(r.samples[k + 1].flags, kNoOrientation | kHasDeviceTime | kHasGyro | kHasAccel) << k;
+    EXPECT_DOUBLE_EQ(r.samples[k + 1].device_time, r.samples[k].device_time) << k;
+  }
+  EXPECT_EQ(r.counters.resyncs, 0u);
+}
+
+TEST(PosefairCanDecoder, BrokenRawSetsAreDroppedAndBadRawFramesMalformed) {
+  const CanDecoded r = decode({
+      frame(0x203, "01 00 01 00 02 00 03 00"),  // gyro of seq 1, its end lost
+      frame(0x203, "02 00 01 00 02 00 03 00"),  // seq 2: drops seq 1's set (resync, 8 bytes)
+      frame(0x203, "02 00 01 00 02 00 03 00"),  // gyro again: drops seq 2's set
+      frame(0x203, "02 83 00 00 00 00 00 00"),  // kind 3: malformed
+      frame(0x203, "02 40 00 00 00 00 00 00"),  // reserved bit: malformed
+      frame(0x203, "02 81 00 00"),              // short: malformed
+      frame(0x203, "02 81 00 00 00 00 E8 03"),  // accel, last: completes with the held gyro
+  });
+  EXPECT_EQ(r.counters.resyncs, 2u);
+  EXPECT_EQ(r.counters.malformed, 3u);
+  EXPECT_EQ(r.counters.skipped_bytes, 16u + 8u + 8u + 4u);
+  ASSERT_EQ(r.samples.size(), 1u);
+  EXPECT_EQ(r.samples[0].flags, kNoOrientation | kHasGyro | kHasAccel);  // no TIME of seq 2
+  EXPECT_NEAR(r.samples[0].accel.z(), 10.0, 1e-12);
+  EXPECT_NEAR((r.samples[0].gyro - Vec3(0.001, 0.002, 0.003)).norm(), 0, 1e-15);
+}
+
 // The quaternion rotates sensor coordinates into the world: +90° about z maps x onto +y.
 TEST(PosefairCanDecoder, NoConjugateSensorToWorld) {
   const double h = std::sqrt(0.5);
@@ -220,10 +292,13 @@ TEST(PosefairCanDecoder, OtherFramesChangeNothingAndFiltersPassItsFrames) {
   }
   auto with = make_posefair_can_decoder();
   auto without = make_posefair_can_decoder();
-  // 0x203 (B + 3), 0x1FF (B - 1), and 0x202 as an extended identifier are not its frames.
-  expect_other_frames_change_nothing(*with, *without, stream, {0x203, 0x1FF, 0x202 | CanFrame::kEffFlag});
+  const Vec3 g(0.1, 0.2, 0.3);
+  const auto raw = encode_posefair_can_raw(0x200, false, &g, nullptr, nullptr, 7);
+  stream.insert(stream.end(), raw.begin(), raw.end());
+  // 0x204 (B + 4), 0x1FF (B - 1), and 0x202 as an extended identifier are not its frames.
+  expect_other_frames_change_nothing(*with, *without, stream, {0x204, 0x1FF, 0x202 | CanFrame::kEffFlag});
   expect_filters_pass(with->filters(), stream,
-                      {0x203, 0x1FF, 0x202 | CanFrame::kEffFlag, 0x202 | CanFrame::kRtrFlag, 0x602});
+                      {0x204, 0x1FF, 0x202 | CanFrame::kEffFlag, 0x203 | CanFrame::kRtrFlag, 0x602});
 }
 
 TEST(PosefairCanDecoder, OptionsAreCheckedAndTheRegistryKnowsIt) {
@@ -232,9 +307,9 @@ TEST(PosefairCanDecoder, OptionsAreCheckedAndTheRegistryKnowsIt) {
   const auto names = can_decoder_protocols();
   EXPECT_TRUE(std::find(names.begin(), names.end(), "posefair-can") != names.end());
   OptionMap o;
-  o["posefair_base_id"] = std::string("0x7FE");  // B + 2 would be 0x800
+  o["posefair_base_id"] = std::string("0x7FD");  // B + 3 would be 0x800
   EXPECT_THROW(make_posefair_can_decoder(o), std::invalid_argument);
-  o["posefair_base_id"] = std::string("0x7FD");
+  o["posefair_base_id"] = std::string("0x7FC");
   EXPECT_NO_THROW(make_posefair_can_decoder(o));
   o["posefair_base_id"] = std::string("512");
   const CanDecoded r = decode(kDocExample, o);

@@ -250,6 +250,76 @@ TEST(PosefairSerialDecoder, ImpossibleContentsAreMalformed) {
   EXPECT_EQ(ok.samples[0].orientation.w(), 1.0);
 }
 
+// docs/protocol.md, "Raw IMU": the raw-IMU examples byte for byte (bytes and checksums computed
+// there independently of the encoders) and what they decode to.
+TEST(PosefairSerialDecoder, RawImuDocumentExamples) {
+  const Vec3 gyro(0.5, -0.25, 0.125), accel(0.5, -1, 9.8125), mag(20, -5, -40);
+  const std::string pfi = "$PFI,1234567,0.5,-0.25,0.125,0.5,-1,9.8125,20,-5,-40*45\r\n";
+  EXPECT_EQ(encode_posefair_imu_sentence(1234567, gyro, accel, &mag), pfi);
+  const Bytes raw_only = hex(
+      "f5 50 01 0e 28 87 d6 12 00 00 00 00 3f 00 00 80"
+      "be 00 00 00 3e 00 00 00 3f 00 00 80 bf 00 00 1d"
+      "41 00 00 a0 41 00 00 a0 c0 00 00 20 c2 34 6c");
+  const PosefairImuReading imu{gyro, accel};
+  EXPECT_EQ(encode_posefair_frame(1234567, nullptr, nullptr, &imu, &mag), raw_only);
+  const Bytes with_q = hex(
+      "f5 50 01 02 2c ff ff ff ff 00 00 80 3f 00 00 00"
+      "00 00 00 00 00 00 00 00 00 00 00 00 3f 00 00 80"
+      "be 00 00 00 3e 00 00 00 3f 00 00 80 bf 00 00 1d"
+      "41 95 17");
+  const Quat identity = Quat::Identity();
+  EXPECT_EQ(encode_posefair_frame(4294967295u, &identity, nullptr, &imu, nullptr), with_q);
+
+  const Decoded r = decode(cat({as_bytes(pfi), raw_only, with_q}));
+  ASSERT_EQ(r.samples.size(), 3u);
+  EXPECT_EQ(r.counters.frames, 3u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const DecodedSample& x = r.samples[k];
+    EXPECT_EQ(x.flags, kHasDeviceTime | kNoOrientation | kHasGyro | kHasAccel | kHasMag) << k;
+    EXPECT_EQ(x.gyro, gyro) << k;
+    EXPECT_EQ(x.accel, accel) << k;
+    EXPECT_EQ(x.mag, mag) << k;
+    EXPECT_DOUBLE_EQ(x.device_time, 1.234567) << k;
+  }
+  EXPECT_EQ(r.samples[2].flags, kHasDeviceTime | kHasGyro | kHasAccel);
+  EXPECT_EQ(r.samples[2].orientation.coeffs(), identity.coeffs());
+  EXPECT_EQ(r.samples[2].gyro, gyro);
+
+  // Without the magnetometer, every combination of parts round-trips.
+  const Vec3 pos(1, -2, 0.25);
+  const Decoded all = decode(cat({as_bytes(encode_posefair_imu_sentence(7, gyro, accel, nullptr)),
+                                  encode_posefair_frame(8, &identity, &pos, &imu, &mag),
+                                  encode_posefair_frame(9, nullptr, nullptr, nullptr, &mag)}));
+  ASSERT_EQ(all.samples.size(), 3u);
+  EXPECT_EQ(all.samples[0].flags, kHasDeviceTime | kNoOrientation | kHasGyro | kHasAccel);
+  EXPECT_EQ(all.samples[1].flags, kHasDeviceTime | kHasPosition | kHasGyro | kHasAccel | kHasMag);
+  EXPECT_EQ(all.samples[1].position, pos);
+  EXPECT_EQ(all.samples[1].mag, mag);
+  EXPECT_EQ(all.samples[2].flags, kHasDeviceTime | kNoOrientation | kHasMag);
+}
+
+TEST(PosefairSerialDecoder, ImpossibleRawImuContentsAreMalformed) {
+  for (const char* body : {"PFI,1,0,0,0,0,0", "PFI,1,0,0,0,0,0,9.8,1", "PFI,1,0,0,0,0,0,9.8,1,2,3,4",
+                           "PFI,1,nan,0,0,0,0,9.8", "PFI,1,0,0,0,0,0,9.8,1,2,inf", "PFI,,0,0,0,0,0,9.8"}) {
+    const Decoded r = decode(cat({sentence(body), as_bytes(encode_posefair_sentence(9, Quat::Identity(), nullptr))}));
+    EXPECT_EQ(r.counters.malformed, 1u) << body;
+    ASSERT_EQ(r.samples.size(), 1u) << body;
+  }
+  const std::vector<Bytes> frames = {
+      frame(1, 0x08, le_floats({}, 1)),                                         // no orientation and nothing else
+      frame(1, 0x09, le_floats({1, 2, 3}, 1)),                                  // no orientation with a position
+      frame(1, 0x0A, le_floats({0, 0, 0, 0, 0}, 1)),                            // one number short
+      frame(1, 0x0A, le_floats({0, 0, NAN, 0, 0, 9.8f}, 1)),                    // NaN gyro
+      frame(1, 0x06, le_floats({1, 0, 0, 0, 0, 0, 0, 0, 0, 9.8f, 1, 2, INFINITY}, 1)),  // infinite mag
+      frame(1, 0x12, le_floats({1, 0, 0, 0, 0, 0, 0, 0, 0, 9.8f}, 1)),          // reserved bit 4
+  };
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const Decoded r = decode(cat({frames[k], encode_posefair_frame(9, Quat::Identity(), nullptr)}));
+    EXPECT_EQ(r.counters.malformed, 1u) << k;
+    ASSERT_EQ(r.samples.size(), 1u) << k;
+  }
+}
+
 TEST(PosefairSerialDecoder, OtherSentencesAndVersionsAreIgnored) {
   const Decoded r = decode(cat({sentence("GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,"),
                                 sentence("PFX,1,1,0,0,0"), sentence("PFQX,1,1,0,0,0"), frame(2, 0, Bytes(40, 7)),
@@ -366,13 +436,13 @@ TEST(PosefairSerialDecoder, AbsurdLengthDoesNotStall) {
   const Bytes good = encode_posefair_frame(3, Quat::Identity(), nullptr);
   d->feed(cat({{0xF5, 0x50, 0x01, 0x00, 0xFF}, good}), c);
   EXPECT_EQ(c.samples.size(), 1u);
-  d->feed(cat({{0xF5, 0x50, 0x01, 0x00, 65}, good}), c);
+  d->feed(cat({{0xF5, 0x50, 0x01, 0x00, 69}, good}), c);
   EXPECT_EQ(c.samples.size(), 2u);
   EXPECT_EQ(d->counters().malformed, 2u);
-  // 64 is within the bound: the decoder waits for it.
-  d->feed(cat({{0xF5, 0x50, 0x01, 0x00, 64}, good}), c);
+  // 68 is within the bound: the decoder waits for it.
+  d->feed(cat({{0xF5, 0x50, 0x01, 0x00, 68}, good}), c);
   EXPECT_EQ(c.samples.size(), 2u);
-  d->feed(Bytes(64, 0x00), c);
+  d->feed(Bytes(68, 0x00), c);
   EXPECT_EQ(c.samples.size(), 3u);
   EXPECT_EQ(d->counters().malformed, 2u);
   EXPECT_EQ(d->counters().bad_checksum, 1u);

@@ -108,6 +108,55 @@ TEST(VectorNavDecoder, VendorPayloadsUnderAsyncHeadersDecodeToTheirValues) {
   EXPECT_NEAR(got9.norm(), 1.0, 1e-15);
 }
 
+// VNQMR and VNYMR carry the compensated magnetic (Gauss), acceleration (m/s²) and angular rate
+// (rad/s) beside the attitude: the sample has all of them, the field in µT.
+TEST(VectorNavDecoder, AttitudeSentencesCarryTheirReadings) {
+  const Decoded qmr = decode(kQmr15);
+  ASSERT_EQ(qmr.samples.size(), 1u);
+  EXPECT_EQ(qmr.samples[0].flags, kHasMag | kHasAccel | kHasGyro);
+  EXPECT_NEAR((qmr.samples[0].mag - Vec3(106.70, -25.68, 306.96)).norm(), 0, 1e-9);
+  EXPECT_EQ(qmr.samples[0].accel, Vec3(-0.019, 0.320, -9.802));
+  EXPECT_EQ(qmr.samples[0].gyro, Vec3(-0.002801, -0.001186, -0.001582));
+  const Decoded ymr = decode(kYmr27);
+  ASSERT_EQ(ymr.samples.size(), 1u);
+  EXPECT_EQ(ymr.samples[0].accel, Vec3(0.005, 0.344, -9.758));
+  EXPECT_EQ(decode(kQtn9).samples[0].flags, 0u);  // the attitude alone
+}
+
+// Register 20's example response (UM001 §7.2.8, checksum as printed, VersaSync appendix 5.3.4.7)
+// is a register reply: ignored. Its payload under the async header $VNMAR (checksum computed for
+// this test) is a raw-only sample; so are $VNIMU (register 54, temperature and pressure not
+// read) and the single-triple outputs.
+TEST(VectorNavDecoder, RawOutputsGiveRawOnlySamples) {
+  const std::string reg20 = "$VNRRG,20,+1.0684,-0.2578,+3.0649,-00.005,+00.341,-09.780,-0.000963,+0.000840,-0.000466*64\r\n";
+  const std::string mar = "$VNMAR,+1.0684,-0.2578,+3.0649,-00.005,+00.341,-09.780,-0.000963,+0.000840,-0.000466*53\r\n";
+  const Decoded r = decode(reg20 + mar);
+  EXPECT_EQ(r.counters.frames, 2u);
+  EXPECT_EQ(r.counters.ignored_frames, 1u);
+  ASSERT_EQ(r.samples.size(), 1u);
+  const DecodedSample& s = r.samples[0];
+  EXPECT_EQ(s.flags, kNoOrientation | kHasMag | kHasAccel | kHasGyro);
+  EXPECT_NEAR((s.mag - Vec3(106.84, -25.78, 306.49)).norm(), 0, 1e-9);
+  EXPECT_EQ(s.accel, Vec3(-0.005, 0.341, -9.780));
+  EXPECT_EQ(s.gyro, Vec3(-0.000963, 0.000840, -0.000466));
+
+  const std::string imu_body = "VNIMU,-02.0841,+00.6045,+02.8911,+00.381,-00.154,-09.657,-00.005683,+00.001000,-00.002000,+021.6,+00099.761";
+  const Decoded imu = decode("$" + imu_body + "*" + vectornav_checksum(imu_body, false) + "\r\n");
+  ASSERT_EQ(imu.samples.size(), 1u);
+  EXPECT_EQ(imu.samples[0].flags, kNoOrientation | kHasMag | kHasAccel | kHasGyro);
+  EXPECT_EQ(imu.samples[0].gyro, Vec3(-0.005683, 0.001, -0.002));
+  EXPECT_NEAR(imu.samples[0].mag.x(), -208.41, 1e-9);
+
+  const std::string acc_body = "VNACC,+00.013,+00.354,-09.801";  // register 18's example payload
+  const Decoded acc = decode("$" + acc_body + "*" + vectornav_checksum(acc_body, true) + "\r\n");
+  ASSERT_EQ(acc.samples.size(), 1u);
+  EXPECT_EQ(acc.samples[0].flags, kNoOrientation | kHasAccel);
+  EXPECT_EQ(acc.samples[0].accel, Vec3(0.013, 0.354, -9.801));
+
+  const std::string short_body = "VNMAR,+1.0684,-0.2578,+3.0649";  // too few numbers
+  EXPECT_EQ(decode("$" + short_body + "*" + vectornav_checksum(short_body, false) + "\r\n").counters.malformed, 1u);
+}
+
 // The manual's examples were read one after the other from one sensor: the Euler and the
 // quaternion readings must describe (nearly) the same attitude. Read as body→NED Hamilton
 // quaternions without a conjugate they agree to ~0.1°; conjugated they would be ~2·yaw apart.

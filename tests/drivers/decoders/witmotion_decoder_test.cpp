@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -44,10 +45,14 @@ std::unique_ptr<Decoder> make(const std::string& scalar = "first") {
 
 Decoded decode(const Bytes& stream, const std::string& scalar = "first") { return decode_chunks(make(scalar), stream); }
 
-// Every valid frame is a sample, ignored or malformed; every byte fed is skipped, in a frame, or
-// still held (fewer than a frame).
-void expect_consistent(const DecoderCounters& c) {
-  EXPECT_EQ(c.frames, c.samples + c.ignored_frames + c.malformed);
+// Every valid frame is a sample's orientation or one of its raw readings, ignored or malformed;
+// every byte fed is skipped, in a frame, or still held (fewer than a frame).
+void expect_consistent(const Decoded& r) {
+  const DecoderCounters& c = r.counters;
+  std::uint64_t used = 0;
+  for (const auto& s : r.samples)
+    used += ((s.flags & kNoOrientation) == 0) + std::popcount(s.flags & (kHasGyro | kHasAccel | kHasMag));
+  EXPECT_EQ(c.frames, used + c.ignored_frames + c.malformed);
   EXPECT_LE(c.skipped_bytes + kWitMotionFrameSize * c.frames, c.bytes);
   EXPECT_GT(c.skipped_bytes + kWitMotionFrameSize * c.frames + kWitMotionFrameSize, c.bytes);
 }
@@ -96,7 +101,7 @@ TEST(WitMotionDecoder, DocumentLayoutFrames) {
   const Bytes stream = {
       // 0x50 time: 20(18)-02-29 23:59:59, ms 0x036B = 875
       0x55, 0x50, 0x18, 0x02, 0x1D, 0x17, 0x3B, 0x3B, 0x6B, 0x03, 0xD7,
-      // 0x51 acceleration: a valid frame without an orientation
+      // 0x51 acceleration: az = 0x0800 = 1 g, temperature 0x0A10; the 0x53 sample carries it
       0x55, 0x51, 0x00, 0x00, 0x00, 0x00, 0x00, 0x08, 0x10, 0x0A, 0xC8,
       // 0x53 angles: roll 0x4000 = 90°, pitch 0xE000 = -45°, yaw 0x8000 = -180°, version 0x1234
       0x55, 0x53, 0x00, 0x40, 0x00, 0xE0, 0x00, 0x80, 0x34, 0x12, 0x8E,
@@ -111,8 +116,10 @@ TEST(WitMotionDecoder, DocumentLayoutFrames) {
   EXPECT_LT(so3::rotation_angle(r.samples[0].orientation, zyx(-180.0, -45.0, 90.0)), 1e-12);
   EXPECT_LT(so3::rotation_angle(r.samples[1].orientation, Quat::Identity()), 1e-12);
   EXPECT_LT((r.samples[2].orientation * Vec3::UnitX() - Vec3::UnitY()).norm(), 1e-12);
+  EXPECT_EQ(r.samples[0].flags, kHasDeviceTime | kHasAccel);
+  EXPECT_EQ(r.samples[0].accel, Vec3(0, 0, 9.8));
+  EXPECT_EQ(r.samples[1].flags, kHasDeviceTime);
   for (std::size_t i = 0; i < 2; ++i) {
-    EXPECT_EQ(r.samples[i].flags, kHasDeviceTime);
     EXPECT_DOUBLE_EQ(r.samples[i].device_time, 23 * 3600 + 59 * 60 + 59 + 0.875);
   }
   // The second 0x59 after one time frame belongs to the next cycle, whose time frame is missing.
@@ -125,7 +132,7 @@ TEST(WitMotionDecoder, DocumentLayoutFrames) {
   want.bytes = stream.size();
   want.frames = 5;
   want.samples = 3;
-  want.ignored_frames = 2;  // time and acceleration
+  want.ignored_frames = 1;  // time
   EXPECT_EQ(r.counters, want);
 
   // The encoders write the same bytes.
@@ -236,7 +243,7 @@ TEST(WitMotionDecoder, QuaternionPreferredOverAngles) {
   for (std::size_t i = 0; i < want.size(); ++i) EXPECT_LT(so3::rotation_angle(r.samples[i].orientation, want[i]), 1e-3) << i;
   EXPECT_EQ(r.counters.frames, 9u);
   EXPECT_EQ(r.counters.ignored_frames, 3u);
-  expect_consistent(r.counters);
+  expect_consistent(r);
 }
 
 TEST(WitMotionDecoder, DeviceTimeAndDayRollover) {
@@ -263,23 +270,23 @@ TEST(WitMotionDecoder, DeviceTimeAndDayRollover) {
   const Decoded r = decode(s);
   ASSERT_EQ(r.samples.size(), 8u);
   const double day = 86400.0;
-  EXPECT_EQ(r.samples[0].flags, kHasDeviceTime);
+  EXPECT_EQ(r.samples[0].flags, kHasDeviceTime | kHasAccel);
   EXPECT_DOUBLE_EQ(r.samples[0].device_time, day - 0.1);
   EXPECT_DOUBLE_EQ(r.samples[1].device_time, day + 0.1);
-  EXPECT_EQ(r.samples[2].flags, 0u);
+  EXPECT_EQ(r.samples[2].flags, kHasAccel);
   EXPECT_DOUBLE_EQ(r.samples[3].device_time, day + 0.3);
   EXPECT_DOUBLE_EQ(r.samples[4].device_time, day + 23 * 3600 + 0.3);
   EXPECT_DOUBLE_EQ(r.samples[5].device_time, day + 22 * 3600 + 0.3);
   EXPECT_EQ(r.samples[6].flags, 0u);
   EXPECT_EQ(r.samples[7].flags, 0u);
   EXPECT_EQ(r.counters.malformed, 2u);
-  expect_consistent(r.counters);
+  expect_consistent(r);
 
   // reset() forgets the day count; without time frames there is no device time.
   auto d = make();
   Collector sink;
   d->feed(std::span<const std::uint8_t>(s.data(), 22), sink);  // time 23:59:59.9, accel
-  d->reset();
+  d->reset();  // forgets the held acceleration too
   Bytes t;
   append(t, q);
   append(t, encode_witmotion_time(25, 1, 1, 0, 0, 0, 100));
@@ -301,7 +308,7 @@ TEST(WitMotionDecoder, AnySplitGivesTheSameSamplesAndCounters) {
   expect_every_split_same(fresh, stream, whole);
   expect_byte_by_byte_same(fresh, stream, whole);
   expect_random_chunkings_same(fresh, stream, whole, rng, 300, {40, 12});  // empty chunks too
-  expect_consistent(whole.counters);
+  expect_consistent(whole);
 }
 
 TEST(WitMotionDecoder, CleanStreamHasNoResyncs) {
@@ -312,16 +319,23 @@ TEST(WitMotionDecoder, CleanStreamHasNoResyncs) {
   want.bytes = stream.size();
   want.frames = 600;
   want.samples = 101;          // the first cycle's 0x53, then one 0x59 per cycle
-  want.ignored_frames = 499;   // 100 each of time, accel, gyro, mag; 99 angles
+  want.ignored_frames = 199;   // 100 time frames, 99 angles
   EXPECT_EQ(r.counters, want);
-  for (const auto& s : r.samples) EXPECT_EQ(s.flags, kHasDeviceTime);
+  // The first cycle's 0x53 carries its accel and gyro, its 0x59 the mag that came between; then
+  // each 0x59 carries all three of its cycle.
+  ASSERT_EQ(r.samples.size(), 101u);
+  EXPECT_EQ(r.samples[0].flags, kHasDeviceTime | kHasAccel | kHasGyro);
+  EXPECT_EQ(r.samples[1].flags, kHasDeviceTime | kHasMag);
+  for (std::size_t i = 2; i < r.samples.size(); ++i)
+    EXPECT_EQ(r.samples[i].flags, kHasDeviceTime | kHasAccel | kHasGyro | kHasMag) << i;
+  expect_consistent(r);
 }
 
 // Garbage before, between and inside frames, a broken checksum with 0x55 0x59 inside it, and a
 // trailing partial frame; every counter derived by hand.
 TEST(WitMotionDecoder, ResynchronisationCountedExactly) {
   const auto f1 = encode_witmotion_angles(10, 20, 30);                                       // a sample
-  const auto f2 = encode_witmotion_frame(0x51, {0x55, 0x55, 0x55, 0x59, 0x00, 0x55, 0x01, 0x02});  // ignored
+  const auto f2 = encode_witmotion_frame(0x51, {0x55, 0x55, 0x55, 0x59, 0x00, 0x55, 0x01, 0x02});  // f4 carries it
   auto f3 = encode_witmotion_frame(0x59, {0x00, 0x40, 0x55, 0x59, 0x00, 0x40, 0x00, 0x40});  // broken below
   f3[10] = static_cast<std::uint8_t>(f3[10] + 1);
   const auto f4 = encode_witmotion_quaternion(zyx(40, 0, 0));  // a sample
@@ -355,7 +369,6 @@ TEST(WitMotionDecoder, ResynchronisationCountedExactly) {
   want.bytes = s.size();
   want.frames = 3;
   want.samples = 2;
-  want.ignored_frames = 1;
   want.bad_checksum = 3;  // G2's false start, f3, the 0x55 0x59 inside f3
   want.resyncs = 3;       // G1, G2, f3
   want.skipped_bytes = 4 + 3 + 11;
@@ -363,6 +376,7 @@ TEST(WitMotionDecoder, ResynchronisationCountedExactly) {
   ASSERT_EQ(sink.samples.size(), 2u);
   EXPECT_LT(so3::rotation_angle(sink.samples[0].orientation, zyx(30, 20, 10)), 1e-3);
   EXPECT_LT(so3::rotation_angle(sink.samples[1].orientation, zyx(40, 0, 0)), 1e-3);
+  EXPECT_EQ(sink.samples[1].flags, kHasAccel);
 
   d->feed(std::span<const std::uint8_t>(f5.data() + 2, f5.size() - 2), sink);
   want.bytes += f5.size() - 2;
@@ -400,7 +414,7 @@ TEST(WitMotionDecoder, MalformedFrames) {
   EXPECT_EQ(r.counters.frames, 4u);
   EXPECT_EQ(r.counters.malformed, 3u);
   EXPECT_EQ(r.counters.samples, 1u);
-  expect_consistent(r.counters);
+  expect_consistent(r);
 }
 
 TEST(WitMotionDecoder, ResetForgetsAPartialFrame) {
@@ -417,6 +431,111 @@ TEST(WitMotionDecoder, ResetForgetsAPartialFrame) {
   EXPECT_EQ(sink.samples.size(), 1u);
 }
 
+// Raw packets written by hand from the documented layouts and formulas (HWT905-TTL "Protocol":
+// acceleration int16/32768·16 g with g = 9.8 m/s², angular velocity int16/32768·2000 °/s;
+// WT901BLECL Datasheet 6.1.2.1: magnetic field in mG, its example x = 360, y = 105, z = 122).
+TEST(WitMotionDecoder, RawPacketsInSIUnits) {
+  const Bytes stream = {
+      // 0x51: ax 0, ay 0xF800 = -1 g, az 0x0800 = +1 g, temperature 0x0A10 = 25.76 °C
+      0x55, 0x51, 0x00, 0x00, 0x00, 0xF8, 0x00, 0x08, 0x10, 0x0A, 0xC0,
+      // 0x52: wx 0x0B60 = 2912 -> 177.734375 °/s, wy 0xFFF0 = -16 -> -0.9765625 °/s, wz 0
+      0x55, 0x52, 0x60, 0x0B, 0xF0, 0xFF, 0x00, 0x00, 0x10, 0x0A, 0x1B,
+      // 0x54: the datasheet's example field, 360 105 122 mG
+      0x55, 0x54, 0x68, 0x01, 0x69, 0x00, 0x7A, 0x00, 0x00, 0x00, 0xF5,
+      // 0x59 at rest: takes the three readings
+      0x55, 0x59, 0xFF, 0x7F, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x2C,
+  };
+  const Decoded r = decode(stream);
+  ASSERT_EQ(r.samples.size(), 1u);
+  const DecodedSample& s = r.samples[0];
+  EXPECT_EQ(s.flags, kHasAccel | kHasGyro | kHasMag);
+  EXPECT_NEAR((s.accel - Vec3(0, -9.8, 9.8)).norm(), 0, 1e-12);
+  EXPECT_NEAR((s.gyro - Vec3(177.734375, -0.9765625, 0) * kDeg).norm(), 0, 1e-12);
+  EXPECT_NEAR((s.mag - Vec3(36.0, 10.5, 12.2)).norm(), 0, 1e-12);
+  EXPECT_EQ(r.counters.frames, 4u);
+  EXPECT_EQ(r.counters.ignored_frames, 0u);
+  expect_consistent(r);
+
+  // The encoder writes the same bytes.
+  const auto acc = encode_witmotion_vector(0x51, Vec3(0, -9.8, 9.8), 0x0A10);
+  EXPECT_TRUE(std::equal(acc.begin(), acc.end(), stream.begin()));
+  const auto gyr = encode_witmotion_vector(0x52, Vec3(177.734375, -0.9765625, 0) * kDeg, 0x0A10);
+  EXPECT_TRUE(std::equal(gyr.begin(), gyr.end(), stream.begin() + 11));
+  const auto mag = encode_witmotion_vector(0x54, Vec3(36.0, 10.5, 12.2));
+  EXPECT_TRUE(std::equal(mag.begin(), mag.end(), stream.begin() + 22));
+}
+
+// A device set to send time, accel, gyro and mag only (no 0x53, no 0x59): raw-only samples, the
+// first two when the next cycle starts, then each at its cycle's last packet (0x54).
+TEST(WitMotionDecoder, RawOnlyCyclesGiveRawOnlySamples) {
+  Bytes s;
+  for (int k = 0; k < 4; ++k) {
+    append(s, encode_witmotion_time(26, 12, 2, 10, 0, 0, 10 * k));
+    append(s, encode_witmotion_vector(0x51, Vec3(0, 0, 9.8 + k)));
+    append(s, encode_witmotion_vector(0x52, Vec3(0.5 * k, 0, 0)));
+    append(s, encode_witmotion_vector(0x54, Vec3(20, 0, -40)));
+  }
+  auto d = make();
+  Collector sink;
+  d->feed(std::span<const std::uint8_t>(s.data(), 44 + 11), sink);  // cycle 1, then cycle 2's time
+  ASSERT_EQ(sink.samples.size(), 1u);
+  d->feed(std::span<const std::uint8_t>(s.data() + 55, 44), sink);  // cycle 2, then cycle 3's time
+  ASSERT_EQ(sink.samples.size(), 2u);
+  d->feed(std::span<const std::uint8_t>(s.data() + 99, 33), sink);  // cycle 3 through its 0x54
+  ASSERT_EQ(sink.samples.size(), 3u);                              // without waiting for cycle 4
+  d->feed(std::span<const std::uint8_t>(s.data() + 132, s.size() - 132), sink);
+  ASSERT_EQ(sink.samples.size(), 4u);
+  for (int k = 0; k < 4; ++k) {
+    const DecodedSample& x = sink.samples[static_cast<std::size_t>(k)];
+    EXPECT_EQ(x.flags, kNoOrientation | kHasAccel | kHasGyro | kHasMag | kHasDeviceTime) << k;
+    EXPECT_NEAR(x.accel.z(), 9.8 + k, 0.005) << k;
+    EXPECT_NEAR(x.gyro.x(), 0.5 * k, 0.002) << k;
+    EXPECT_NEAR((x.mag - Vec3(20, 0, -40)).norm(), 0, 1e-12) << k;
+    EXPECT_DOUBLE_EQ(x.device_time, 36000.0 + 0.01 * k) << k;
+  }
+  EXPECT_EQ(d->counters().ignored_frames, 4u);  // the time frames
+}
+
+// One lost 0x59 sends its cycle's acceleration alone, and the next cycle's acceleration still
+// goes with the next 0x59.
+TEST(WitMotionDecoder, LostOrientationFrameSendsItsReadingsAlone) {
+  Bytes s;
+  for (int k = 0; k < 4; ++k) {
+    append(s, encode_witmotion_time(26, 12, 2, 10, 0, 0, 10 * k));
+    append(s, encode_witmotion_vector(0x51, Vec3(0, 0, 9.8)));
+    auto q = encode_witmotion_quaternion(zyx(10.0 * k, 0, 0));
+    if (k == 1) q[10] ^= 1;  // bad checksum
+    append(s, q);
+  }
+  const Decoded r = decode(s);
+  ASSERT_EQ(r.samples.size(), 4u);
+  EXPECT_EQ(r.samples[0].flags, kHasDeviceTime | kHasAccel);
+  EXPECT_EQ(r.samples[1].flags, kHasDeviceTime | kHasAccel | kNoOrientation);
+  EXPECT_DOUBLE_EQ(r.samples[1].device_time, 36000.01);  // its own cycle's time
+  EXPECT_EQ(r.samples[2].flags, kHasDeviceTime | kHasAccel);
+  EXPECT_LT(so3::rotation_angle(r.samples[2].orientation, zyx(20, 0, 0)), 1e-3);
+  EXPECT_EQ(r.samples[3].flags, kHasDeviceTime | kHasAccel);
+}
+
+// Angles-only output with the magnetic field on: 0x54 comes after the cycle's 0x53, which
+// carries accel and gyro; the field goes out alone, never onto the next cycle's orientation.
+TEST(WitMotionDecoder, FieldAfterAnglesGoesOutAlone) {
+  Bytes s;
+  for (int k = 0; k < 3; ++k) {
+    append(s, encode_witmotion_vector(0x51, Vec3(0, 0, 9.8)));
+    append(s, encode_witmotion_vector(0x52, Vec3(0, 0, 1)));
+    append(s, encode_witmotion_angles(10, 0, 0));
+    append(s, encode_witmotion_vector(0x54, Vec3(30, 0, 0)));
+  }
+  const Decoded r = decode(s);
+  ASSERT_EQ(r.samples.size(), 6u);
+  for (std::size_t k = 0; k < 6; k += 2) {
+    EXPECT_EQ(r.samples[k].flags, kHasAccel | kHasGyro) << k;
+    EXPECT_EQ(r.samples[k + 1].flags, kNoOrientation | kHasMag) << k;  // when the next 0x51 repeats a type, then at once
+  }
+  expect_consistent(r);
+}
+
 // 10 MB of random bytes: no crash, only unit quaternions, and about as many accepted frames and
 // failed checksums as the frame rules predict. At each position a frame is accepted with
 // probability 1/256 (0x55) · 16/256 (type 0x50..0x5F) · 1/256 (checksum) = 2^-20, and a checksum
@@ -429,7 +548,7 @@ TEST(WitMotionDecoder, RandomBytes) {
     const Decoded r = decode_in_random_reads(make(scalar), data, rng);
     const DecoderCounters& c = r.counters;
     EXPECT_EQ(c.bytes, kBytes);
-    expect_consistent(c);
+    expect_consistent(r);
     expect_poisson_at_most(c.frames, kBytes / 1048576.0);
     expect_poisson_near(c.bad_checksum, kBytes * (1.0 / 256) * (16.0 / 256) * (255.0 / 256));
     expect_unit_quaternions(r.samples);

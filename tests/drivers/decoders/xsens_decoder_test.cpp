@@ -121,14 +121,24 @@ TEST(XsensDecoder, DocumentedMessagesHaveValidChecksums) {
   EXPECT_FALSE(sums_to_zero(go_to_config));
 }
 
-TEST(XsensDecoder, DocumentedSessionIsValidFramesWithoutOrientation) {
+// The session's MTData2 message has acceleration and rate of turn but no quaternion: a raw-only
+// sample with the float32 values as the bytes give them (MT0101P: m/s², rad/s).
+TEST(XsensDecoder, DocumentedSessionIsValidFramesAndOneRawOnlySample) {
   Bytes stream;
   for (const char* m : kMtiDocsSession) stream = cat({stream, hex(m)});
   stream = cat({stream, hex(kMtiDocsMtData2)});
   const Decoded r = decode(stream);
   EXPECT_EQ(r.counters.frames, 10u);
-  EXPECT_EQ(r.counters.ignored_frames, 10u);
-  EXPECT_EQ(r.counters.samples, 0u);
+  EXPECT_EQ(r.counters.ignored_frames, 9u);
+  EXPECT_EQ(r.counters.samples, 1u);
+  ASSERT_EQ(r.samples.size(), 1u);
+  const DecodedSample& s = r.samples[0];
+  EXPECT_EQ(s.flags, kNoOrientation | kHasAccel | kHasGyro | kHasDeviceTime);
+  // BE DC 9A FA, 3F 54 9F 37, 41 1C BB 70; BB AA 5C 80, 3B 8C 55 01, BB 81 33 00
+  EXPECT_EQ(s.accel, Vec3(-0.4308698773384094, 0.8305544257164001, 9.795761108398438));
+  EXPECT_EQ(s.gyro, Vec3(-0.005199015140533447, 0.004282594192773104, -0.00394284725189209));
+  EXPECT_TRUE(s.has_frame_counter);
+  EXPECT_EQ(s.frame_counter, 0xDFC5u);
   EXPECT_EQ(r.counters.bad_checksum, 0u);
   EXPECT_EQ(r.counters.malformed, 0u);
   EXPECT_EQ(r.counters.skipped_bytes, 0u);
@@ -145,15 +155,16 @@ TEST(XsensDecoder, DocumentedMtData2CounterAndTimeAreRead) {
     std::uint64_t time;
   };
   for (const Case& c : {Case{kMtiDocsMtData2, 0xDFC5, 0x00459DA0}, Case{kFmt1000MtData2, 0x51BC, 0x002149AF}}) {
+    const bool raw = c.message == kMtiDocsMtData2;  // FMT1000's increments are not readings: ignored
     // The next message's counter and time are 1 below the documented ones: only a decoder that
     // read them sees a rollover.
     const auto counter = static_cast<std::uint16_t>(c.counter - 1);
     const auto time = static_cast<std::uint32_t>(c.time - 1);
     const Decoded r = decode(cat({hex(c.message), encode_xsens_mtdata2(Quat::Identity(), counter, time)}));
-    ASSERT_EQ(r.samples.size(), 1u);
-    EXPECT_EQ(r.counters.ignored_frames, 1u);
-    EXPECT_EQ(r.samples[0].frame_counter, c.counter - 1 + 65536);
-    EXPECT_DOUBLE_EQ(r.samples[0].device_time, static_cast<double>(c.time - 1 + (std::uint64_t{1} << 32)) / 1e4);
+    ASSERT_EQ(r.samples.size(), raw ? 2u : 1u);
+    EXPECT_EQ(r.counters.ignored_frames, raw ? 0u : 1u);
+    EXPECT_EQ(r.samples.back().frame_counter, c.counter - 1 + 65536);
+    EXPECT_DOUBLE_EQ(r.samples.back().device_time, static_cast<double>(c.time - 1 + (std::uint64_t{1} << 32)) / 1e4);
   }
 }
 
@@ -194,10 +205,56 @@ TEST(XsensDecoder, RecordedMti300MessagesDecodeAsMtManagerDecodedThem) {
     ASSERT_EQ(r.samples.size(), 1u);
     const DecodedSample& s = r.samples[0];
     expect_wxyz_near(s.orientation, 0.99801278, -0.00879299, 0.00492375, -0.06220087);
+    // Acceleration 0x4020, RateOfTurn 0x8020 and MagneticField 0xC020 ride with it (the free
+    // acceleration 0x4030, DeltaV 0x4010 and DeltaQ 0x8030 are skipped); the field in a.u.
+    // times the default 50 µT.
+    EXPECT_EQ(s.flags, kHasDeviceTime | kHasAccel | kHasGyro | kHasMag);
+    EXPECT_EQ(s.accel, Vec3(-0.07915300130844116, -0.16655954718589783, 9.822175979614258));
+    EXPECT_EQ(s.gyro, Vec3(-0.00541657255962491, -0.004583597183227539, 0.007928908802568913));
+    EXPECT_NEAR((s.mag - 50.0 * Vec3(-0.30001938343048096, 1.4227092266082764, 0.5875689387321472)).norm(), 0, 1e-12);
     EXPECT_EQ(s.frame_counter, 42581u);
     EXPECT_DOUBLE_EQ(s.device_time, 571.9854);
     EXPECT_EQ(r.counters.malformed, 0u);
   }
+}
+
+// xsens_mag_field scales the field; a value that is no field strength is refused by name.
+TEST(XsensDecoder, MagFieldOption) {
+  OptionMap o;
+  o["xsens_mag_field"] = 48.5;
+  const Decoded r = decode_chunks(make_xsens_decoder(o), message(0x36, hex(kMti300BreakdownData)));
+  ASSERT_EQ(r.samples.size(), 1u);
+  EXPECT_NEAR(r.samples[0].mag.y(), 48.5 * 1.4227092266082764, 1e-9);
+  for (const double bad : {0.0, -5.0, 5000.0}) {
+    o["xsens_mag_field"] = bad;
+    try {
+      (void)make_xsens_decoder(o);
+      ADD_FAILURE() << bad;
+    } catch (const OptionError& e) {
+      EXPECT_EQ(e.key(), "xsens_mag_field");
+    }
+  }
+}
+
+// Float64 and Fp1220 vectors; a non-finite reading makes the message malformed.
+TEST(XsensDecoder, RawVectorFormats) {
+  const auto be64 = [](double v) {
+    const auto u = std::bit_cast<std::uint64_t>(v);
+    Bytes b;
+    for (int k = 7; k >= 0; --k) b.push_back(static_cast<std::uint8_t>(u >> (8 * k)));
+    return b;
+  };
+  const Bytes gyro64 = packet(0x8023, cat({be64(0.25), be64(-1.5), be64(3.0)}));
+  const Bytes acc1220 = packet(0x4021, {0x00, 0x10, 0x00, 0x00, 0xFF, 0xF0, 0x00, 0x00, 0x00, 0x9C, 0xCC, 0xCD});  // 1, -1, 9.8
+  const Decoded r = decode(message(0x36, cat({gyro64, acc1220})));
+  ASSERT_EQ(r.samples.size(), 1u);
+  EXPECT_EQ(r.samples[0].flags, kNoOrientation | kHasGyro | kHasAccel);
+  EXPECT_EQ(r.samples[0].gyro, Vec3(0.25, -1.5, 3.0));
+  EXPECT_NEAR((r.samples[0].accel - Vec3(1, -1, 9.8)).norm(), 0, 1e-6);
+  const Bytes nan_acc = packet(0x4020, cat({be_float(1.0f), be_float(std::nanf("")), be_float(0.0f)}));
+  const Decoded bad = decode(message(0x36, nan_acc));
+  EXPECT_EQ(bad.samples.size(), 0u);
+  EXPECT_EQ(bad.counters.malformed, 1u);
 }
 
 // Xsens' q_LS rotates sensor coordinates into the earth frame, as posefair's q does: a

@@ -20,6 +20,7 @@ struct StreamCounters {
   std::atomic<std::uint64_t> received{0};         // handed over by the driver
   std::atomic<std::uint64_t> rejected{0};         // refused by the engine's gate (NaN, zero, non-unit)
   std::atomic<std::uint64_t> out_of_order{0};     // dropped by the gate (repeated or older time)
+  std::atomic<std::uint64_t> raw_unfused{0};      // raw-only samples (kNoOrientation) kept out of the engine: no fusion stage made an orientation
   std::atomic<std::uint64_t> emitted{0};          // poses the engine produced
   std::atomic<std::uint64_t> clamped{0};          // of which the ε projection moved
   std::atomic<std::uint64_t> restarts{0};         // windows restarted after a gap
@@ -49,6 +50,7 @@ struct StreamStats {
   std::string driver;
   bool driver_running = false;
   std::uint64_t received = 0, ring_dropped = 0, rejected = 0, out_of_order = 0, emitted = 0, clamped = 0, restarts = 0;
+  std::uint64_t raw_unfused = 0;  // raw-only samples not faired (no orientation, no fusion stage); still recorded
   std::uint64_t publish_dropped = 0, published = 0, send_failures = 0, recorded = 0, record_dropped = 0;
   HistogramSnapshot latency;
   EngineState engine;      // rate, window, and the adaptation's noise, motion and cutoff

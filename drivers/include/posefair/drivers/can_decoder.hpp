@@ -17,7 +17,7 @@
 //   samples        samples handed to the sink
 //   bad_checksum   multi-frame transfers whose CRC did not match
 //   malformed      addressed frames or transfers with a wrong length or impossible contents
-//   ignored_frames valid messages without an orientation (status, or a time left unused)
+//   ignored_frames valid messages without an orientation or a raw reading (status, or a time left unused)
 //   resyncs        partial sets or transfers given up (lost frames, the sequence moved on)
 //   skipped_bytes  payload bytes that went into no valid message (malformed frames, parts of
 //                  given-up sets or transfers, stray continuation frames)

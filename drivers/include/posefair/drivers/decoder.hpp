@@ -23,14 +23,33 @@ namespace posefair::drivers {
 
 // One orientation (and perhaps position) a frame carried, in posefair's convention: a unit
 // quaternion (w, x, y, z) rotating sensor coordinates into world coordinates, v_w = q v_s q*.
+// Raw inertial readings ride along in the sensor's own axes, converted to SI units (rad/s, m/s²,
+// µT), either beside that orientation or alone (kNoOrientation: the orientation is not a
+// measurement). Each decoder says in its opening comment how its raw readings attach.
 struct DecodedSample {
   Quat orientation = Quat::Identity();
   Vec3 position = Vec3::Zero();
-  std::uint32_t flags = 0;        // kHasPosition, kHasDeviceTime (core/sample.hpp)
+  Vec3 gyro = Vec3::Zero();       // rad/s, valid with kHasGyro
+  Vec3 accel = Vec3::Zero();      // m/s², valid with kHasAccel
+  Vec3 mag = Vec3::Zero();        // µT, valid with kHasMag
+  std::uint32_t flags = 0;        // kHasPosition, kHasDeviceTime, kHasGyro/Accel/Mag, kNoOrientation (core/sample.hpp)
   double device_time = 0.0;       // s, valid with kHasDeviceTime; rollover already unwrapped
   std::uint64_t frame_counter = 0;  // the device's own packet counter, where it sends one (unwrapped)
   bool has_frame_counter = false;
 };
+
+// What a decoded sample gives a Sample: its flags (the Sample's kinds only: kHasPosition,
+// kHasDeviceTime, the raw readings' and kNoOrientation), orientation, and each value its flags
+// declare. Stream id, sequence and times are the stamper's.
+inline void fill_sample(const DecodedSample& d, Sample& s) {
+  s.flags = d.flags & (kHasPosition | kHasDeviceTime | kHasGyro | kHasAccel | kHasMag | kNoOrientation);
+  s.orientation = d.orientation;
+  if (s.has_position()) s.position = d.position;
+  if ((s.flags & kHasDeviceTime) != 0) s.device_time = d.device_time;
+  if (s.has_gyro()) s.gyro = d.gyro;
+  if (s.has_accel()) s.accel = d.accel;
+  if (s.has_mag()) s.mag = d.mag;
+}
 
 struct DecoderCounters {
   std::uint64_t bytes = 0;           // bytes fed
@@ -38,7 +57,7 @@ struct DecoderCounters {
   std::uint64_t samples = 0;         // samples handed to the sink
   std::uint64_t bad_checksum = 0;    // whole frames whose checksum did not match
   std::uint64_t malformed = 0;       // frames with a valid checksum but impossible contents (bad length field, NaN, zero quaternion)
-  std::uint64_t ignored_frames = 0;  // valid frames of kinds without an orientation (e.g. WitMotion 0x51 acceleration)
+  std::uint64_t ignored_frames = 0;  // valid frames that give no sample and no raw reading (e.g. WitMotion 0x56 pressure)
   std::uint64_t resyncs = 0;         // times the decoder had to skip bytes to find a frame start
   std::uint64_t skipped_bytes = 0;   // bytes skipped while resynchronising
   friend bool operator==(const DecoderCounters&, const DecoderCounters&) = default;

@@ -33,6 +33,12 @@ std::array<std::uint8_t, kWitMotionFrameSize> encode_witmotion_quaternion(const 
 std::array<std::uint8_t, kWitMotionFrameSize> encode_witmotion_angles(double roll_deg, double pitch_deg, double yaw_deg,
                                                                       std::uint16_t version = 0);
 
+// 0x51 (v in m/s²), 0x52 (rad/s) or 0x54 (µT): each component in the packet's units (16 g ·
+// 9.8 m/s² / 32768, 2000 °/s / 32768, 0.1 µT per count), rounded and saturated to int16; then
+// the temperature word (°C · 100 on the 0x51 and 0x52 packets).
+std::array<std::uint8_t, kWitMotionFrameSize> encode_witmotion_vector(std::uint8_t type, const Vec3& v,
+                                                                      std::uint16_t temperature = 0);
+
 // 0x50: year (20YY: pass YY, 0..99), month, day, hour, minute, second, millisecond. Each field is
 // written as given (truncated to its byte / 16-bit word), so tests can build impossible times.
 std::array<std::uint8_t, kWitMotionFrameSize> encode_witmotion_time(int yy, int month, int day, int hour, int minute,

@@ -9,7 +9,12 @@
 //             stream_count:u16 { id:u32 name:str16 source:str16 }*  [reserved bytes]  crc:u32
 //   record  = body_length:u32  type:u8  body[body_length]  crc:u32   (crc over type + body)
 //   sample  = stream_id:u32 sequence:u64 time:f64 device_time:f64 receive_time:f64 flags:u32
-//             w:f64 x:f64 y:f64 z:f64 px:f64 py:f64 pz:f64                 (96 bytes)
+//             w:f64 x:f64 y:f64 z:f64 px:f64 py:f64 pz:f64                 (96 bytes, type 1)
+//   imu sample = sample  gx:f64 gy:f64 gz:f64 ax:f64 ay:f64 az:f64 mx:f64 my:f64 mz:f64
+//                                                                            (168 bytes, type 2)
+// A sample with raw inertial readings (or without an orientation) is written as type 2, every
+// other as type 1, so a log without raw readings is byte for byte what it was before type 2,
+// and an older reader skips (and counts) type 2 records instead of misreading them.
 //
 // Rotation: a writer with max_file_bytes set continues a recording in further files, each a
 // complete log with the same header: "<base>.pflog" (the path as given), then
@@ -44,6 +49,8 @@ inline constexpr std::size_t kSampleLogMaxHeaderBytes = 0xFFFF;
 inline constexpr std::size_t kRecordOverheadBytes = 4 + 1 + 4;
 inline constexpr std::size_t kSampleBodyBytes = 4 + 8 + 3 * 8 + 4 + 4 * 8 + 3 * 8;  // 96
 inline constexpr std::size_t kSampleRecordBytes = kRecordOverheadBytes + kSampleBodyBytes;  // 105
+inline constexpr std::size_t kImuSampleBodyBytes = kSampleBodyBytes + 9 * 8;                     // 168
+inline constexpr std::size_t kImuSampleRecordBytes = kRecordOverheadBytes + kImuSampleBodyBytes;  // 177
 // A body_length above this is treated as a corrupt length field, not as a huge record.
 inline constexpr std::uint32_t kMaxRecordBodyBytes = 1u << 20;
 
@@ -51,6 +58,7 @@ inline constexpr std::uint32_t kMaxRecordBodyBytes = 1u << 20;
 // configuration snapshots, driver diagnostics ...) can be added without a version bump.
 enum class RecordType : std::uint8_t {
   Sample = 1,
+  ImuSample = 2,  // a sample with raw inertial readings or without an orientation (issue 17)
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -77,12 +85,19 @@ struct SampleLogHeader {
 // longer than 65535 bytes.
 std::vector<unsigned char> encode_sample_log_header(const SampleLogHeader& header);
 
-// A whole sample record (length, type, body, CRC) into out[0, kSampleRecordBytes). Values are
-// stored bit for bit (NaN payloads, -0, non-unit quaternions included); the position is
-// written even when kHasPosition is not set (whatever the sample holds, normally zero).
-void encode_sample_record(const Sample& sample, unsigned char* out);
-// The sample from a sample body (kSampleBodyBytes bytes at `body`).
+// The record a sample is written as: ImuSample when it has kHasGyro, kHasAccel, kHasMag or
+// kNoOrientation, else Sample; and that record's size in bytes.
+RecordType sample_record_type(const Sample& sample);
+std::size_t sample_record_bytes(const Sample& sample);
+// A whole sample record (length, type, body, CRC) into out[0, sample_record_bytes(sample));
+// returns that size. Values are stored bit for bit (NaN payloads, -0, non-unit quaternions
+// included); the position (and in an ImuSample the three readings) is written even when its
+// flag is not set (whatever the sample holds, normally zero).
+std::size_t encode_sample_record(const Sample& sample, unsigned char* out);
+// The sample from a sample body (kSampleBodyBytes bytes at `body`), and from an IMU sample
+// body (kImuSampleBodyBytes).
 Sample decode_sample_body(const unsigned char* body);
+Sample decode_imu_sample_body(const unsigned char* body);
 
 // ---------------------------------------------------------------------------------------------
 // Errors
