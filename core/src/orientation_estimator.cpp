@@ -41,6 +41,14 @@ void OrientationEstimator::update(const Sample& sample, double dt) {
   };
   ImuStep in;
   in.gyro = reading(sample.has_gyro(), sample.gyro);
+  // A missing gyroscope reading is bridged with the last good one (the motion goes on; a
+  // skipped step would lose its rotation for good).
+  if (in.gyro != nullptr) {
+    last_gyro_ = *in.gyro;
+    have_gyro_ = true;
+  } else if (have_gyro_ && started_) {
+    in.gyro = &last_gyro_;
+  }
   in.accel = reading(sample.has_accel(), sample.accel);
   if (in.accel != nullptr && in.accel->squaredNorm() == 0.0) in.accel = nullptr;
   if (limits_.use_mag) {
@@ -65,6 +73,7 @@ void OrientationEstimator::update(const Sample& sample, double dt) {
     ++state_.gaps;
     after_gap();
     mag_unchanged_for_ = 0.0;
+    have_gyro_ = false;
     return;  // the motion over the gap is unknown: continue from the next sample
   }
   in.dt = dt;
@@ -72,6 +81,7 @@ void OrientationEstimator::update(const Sample& sample, double dt) {
   if (in.gyro != nullptr && in.gyro->cwiseAbs().maxCoeff() >= limits_.gyro_range) {
     ++state_.gyro_saturated;
     in.gyro_saturated = true;
+    after_gap();  // the integrated motion is wrong by an unknown amount: re-converge fast
   }
   if (in.mag != nullptr) {
     if (*in.mag == last_mag_) {

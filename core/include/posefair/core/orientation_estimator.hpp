@@ -92,6 +92,8 @@ class OrientationEstimator {
  private:
   EstimatorLimits limits_;
   bool started_ = false;
+  Vec3 last_gyro_ = Vec3::Zero();
+  bool have_gyro_ = false;
   Vec3 last_mag_ = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
   double mag_unchanged_for_ = 0.0;
 };
