@@ -1,6 +1,7 @@
 // posefair fuse (docs/fusion.md): raw IMU CSV in, orientation out.
 #include "fuse_command.hpp"
 
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -46,6 +47,10 @@ int run_fuse(const FuseOptions& o) {
   } catch (const std::invalid_argument& e) {
     std::cerr << "posefair fuse: --set " << e.what() << "\n";
     return exit_code(ErrorKind::Usage);
+  }
+  if (!std::filesystem::is_regular_file(o.input)) {
+    std::cerr << "posefair fuse: cannot open " << o.input << "\n";
+    return exit_code(ErrorKind::NoInput);
   }
   formats::ImuRecording recording;
   std::optional<MagnetometerCalibration> calibration;

@@ -9,6 +9,11 @@
 
 namespace posefair {
 
+namespace {
+constexpr double kMaxRelativeResidual = 0.1;  // of the field strength
+constexpr double kMinDirectionSpread = 0.02;  // smallest eigenvalue of E[u u^T] (sphere: 1/3)
+}  // namespace
+
 MagnetometerCalibration fit_magnetometer_calibration(std::span<const Vec3> readings) {
   const char* advice = "; turn the sensor through as many orientations as possible while recording";
   if (readings.size() < 9)
@@ -55,9 +60,25 @@ MagnetometerCalibration fit_magnetometer_calibration(std::span<const Vec3> readi
   cal.field_strength = scale * std::pow(lambda.prod(), -1.0 / 6.0);
   cal.soft_iron = eig.eigenvectors() * lambda.cwiseSqrt().asDiagonal() * eig.eigenvectors().transpose() *
                   (cal.field_strength / scale);
+  // Judge the fit: the corrected readings must lie near one sphere (a noise cloud at rest
+  // also "fits" some small ellipsoid, badly), and their directions must spread in all three
+  // axes (covariance of the unit directions: 1/3 each for a fully covered sphere).
   double sum = 0.0;
-  for (const Vec3& m : readings) sum += std::pow(cal.apply(m).norm() - cal.field_strength, 2);
+  Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+  for (const Vec3& m : readings) {
+    const Vec3 c = cal.apply(m);
+    sum += std::pow(c.norm() - cal.field_strength, 2);
+    const Vec3 u = c.normalized();
+    spread += u * u.transpose();
+  }
   cal.residual_rms = std::sqrt(sum / static_cast<double>(readings.size()));
+  spread /= static_cast<double>(readings.size());
+  if (cal.residual_rms > kMaxRelativeResidual * cal.field_strength)
+    throw std::invalid_argument("magnetometer readings lie on no ellipsoid (corrected norms vary by " +
+                                std::to_string(static_cast<int>(100.0 * cal.residual_rms / cal.field_strength)) +
+                                " %)" + advice);
+  if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(spread).eigenvalues().minCoeff() < kMinDirectionSpread)
+    throw std::invalid_argument(std::string("magnetometer readings cover too few directions") + advice);
   return cal;
 }
 

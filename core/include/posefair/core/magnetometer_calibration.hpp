@@ -23,8 +23,9 @@ struct MagnetometerCalibration {
 };
 
 // Throws std::invalid_argument when the readings do not determine an ellipsoid (fewer than 9
-// readings, non-finite ones, or too little of the sphere covered: the fitted quadric is not an
-// ellipsoid), with a message saying to turn the sensor through more orientations.
+// readings, non-finite ones, a quadric that is not an ellipsoid, corrected norms that vary by
+// more than 10 %, or directions that do not spread in all three axes), with a message saying
+// to turn the sensor through more orientations.
 MagnetometerCalibration fit_magnetometer_calibration(std::span<const Vec3> readings);
 
 }  // namespace posefair
