@@ -43,11 +43,11 @@ class VqfEstimator final : public OrientationEstimator {
     mag_norm_dip_lp_.set_coefficients(p_.mag_current_tau, dt);
     k_mag_ = first_order_gain(p_.tau_mag, dt);
     k_mag_ref_ = first_order_gain(p_.mag_ref_tau, dt);
-    // Bias Kalman filter: process noise so that the variance grows back to its initial value
-    // in bias_forgetting_time; measurement noise chosen so that a steady stream of
+    // Bias Kalman filter: process noise such that the uncertainty grows from 0 to 0.1 deg/s in
+    // bias_forgetting_time (the paper's definition of that parameter); measurement noise chosen so that a steady stream of
     // measurements converges to the standard deviation bias_sigma_{motion,rest}: the steady
     // state of P = (P + V) W / (P + V + W) at P = sigma^2 is W = sigma^2 (sigma^2 + V) / V.
-    process_noise_ = p0_ * dt / p_.bias_forgetting_time;
+    process_noise_ = std::pow(0.1 * kDeg, 2) * dt / p_.bias_forgetting_time;
     const auto steady_w = [&](double sigma_deg) {
       const double s2 = std::pow(sigma_deg * kDeg, 2);
       return s2 * (s2 + process_noise_) / process_noise_;
@@ -149,7 +149,9 @@ class VqfEstimator final : public OrientationEstimator {
       e = rest_gyr_lp_.value().matrix() - bias_;
       h.setIdentity();
       w.setConstant(rest_w_);
-    } else if (p_.motion_bias && gyro_ok) {
+    } else if (p_.motion_bias && gyro_ok && acc_lp_.ready() && motion_r_lp_.ready()) {
+      // Only once the filters run: during their start-up (and after a gap) the correction
+      // levels a fresh estimate at once, which is no measure of a drift.
       // The correction turned acc_e up by the rotation vector (a_y, -a_x, 0): at rate
       // ω = (a_y, -a_x)/dt in the earth frame, which cancels the drift R(b - b̂) of a bias error.
       e.x() = -acc_e.y() / dt + bias_lp[0] - r_lp.row(0).dot(bias_);
@@ -302,7 +304,7 @@ constexpr auto kOptions = with_common_estimator_options(std::array<OptionSpec, 2
     {"rest_bias", OptionType::Boolean, "true", "estimate the gyroscope bias at rest"},
     {"mag_rejection", OptionType::Boolean, "true", "detect and reject magnetic disturbances"},
     {"bias_sigma_init", OptionType::Float, "0.5", "deg/s: initial bias uncertainty"},
-    {"bias_forgetting_time", OptionType::Float, "100", "s: time for the bias uncertainty to regrow"},
+    {"bias_forgetting_time", OptionType::Float, "100", "s: time for the bias uncertainty to grow from 0 to 0.1 deg/s"},
     {"bias_clip", OptionType::Float, "2", "deg/s: largest bias estimate"},
     {"bias_sigma_motion", OptionType::Float, "0.1", "deg/s: converged bias uncertainty in motion"},
     {"bias_vertical_forgetting", OptionType::Float, "0.0001",

@@ -64,7 +64,8 @@ class ButterworthLowpass {
   }
 
   const Vector& value() const { return y_; }
-  bool started() const { return count_ > 0.0 || initialised_; }
+  // Past the running-mean start-up: the output is the filter's.
+  bool ready() const { return initialised_; }
 
  private:
   double tau_ = 1.0, dt_ = 0.01;

@@ -25,7 +25,7 @@ struct VqfParameters {
   bool rest_bias = true;
   bool mag_rejection = true;
   double bias_sigma_init = 0.5;            // deg/s
-  double bias_forgetting_time = 100.0;     // s
+  double bias_forgetting_time = 100.0;     // s: the uncertainty grows from 0 to 0.1 deg/s in it
   double bias_clip = 2.0;                  // deg/s
   double bias_sigma_motion = 0.1;          // deg/s
   double bias_vertical_forgetting = 1e-4;  // factor
