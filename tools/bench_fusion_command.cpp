@@ -39,7 +39,7 @@ const std::map<std::string, double> kPublishedMadgwick = {
     {"33_disturbed_attached_magnet_2cm", 7.09},
 };
 
-struct Trial {
+struct FusionTrial {
   std::string name;
   formats::ImuRecording recording;
   std::vector<Quat> reference;
@@ -47,14 +47,14 @@ struct Trial {
   std::vector<std::string> groups;
 };
 
-struct Method {
+struct FusionMethod {
   std::string label;      // column heading
   std::string estimator;  // registry name
   OptionMap options;
   bool six_d = false;
 };
 
-std::vector<Trial> load_trials(const fs::path& dir) {
+std::vector<FusionTrial> load_broad_trials(const fs::path& dir) {
   const fs::path broad = dir / "broad";
   const fs::path index = broad / "trials.json";
   if (!fs::exists(index)) {
@@ -63,11 +63,11 @@ std::vector<Trial> load_trials(const fs::path& dir) {
   }
   std::ifstream in(index);
   const nlohmann::json info = nlohmann::json::parse(in);
-  std::vector<Trial> trials;
+  std::vector<FusionTrial> trials;
   for (const auto& [name, trial] : info.at("trials").items()) {
     const fs::path csv = broad / (name + ".csv");
     if (!fs::exists(csv)) continue;  // trials.json lists all 39; the data set may hold fewer
-    Trial t;
+    FusionTrial t;
     t.name = name;
     for (const auto& g : trial.at("groups")) t.groups.push_back(g.get<std::string>());
     t.recording = formats::read_imu_csv(csv);
@@ -81,11 +81,11 @@ std::vector<Trial> load_trials(const fs::path& dir) {
   if (trials.empty())
     throw std::runtime_error("no BROAD trial CSV found beside " + index.string() + "\n" +
                              where_benchmark_data_is_looked_for());
-  std::sort(trials.begin(), trials.end(), [](const Trial& a, const Trial& b) { return a.name < b.name; });
+  std::sort(trials.begin(), trials.end(), [](const FusionTrial& a, const FusionTrial& b) { return a.name < b.name; });
   return trials;
 }
 
-OrientationRmse score(const Trial& t, const Method& m) {
+OrientationRmse score_fusion(const FusionTrial& t, const FusionMethod& m) {
   OptionMap options = m.options;
   options["magnetometer"] = !m.six_d;
   const auto estimator = make_orientation_estimator(m.estimator, options);
@@ -93,15 +93,15 @@ OrientationRmse score(const Trial& t, const Method& m) {
   return orientation_rmse(estimate, t.reference, t.scored);
 }
 
-double metric(const OrientationRmse& r, bool six_d) { return six_d ? r.inclination_deg : r.total_deg; }
+double fusion_metric(const OrientationRmse& r, bool six_d) { return six_d ? r.inclination_deg : r.total_deg; }
 
 // The beta with the lowest mean error over all trials (BROAD's TAGP), on BROAD's grid.
-double madgwick_tagp_beta(const std::vector<Trial>& trials, bool six_d) {
+double madgwick_tagp_beta(const std::vector<FusionTrial>& trials, bool six_d) {
   double best_beta = 0.0, best = 1e300;
   for (int i = 1; i <= 30; ++i) {
     const double beta = 0.01 * i;
     double sum = 0.0;
-    for (const Trial& t : trials) sum += metric(score(t, {"", "madgwick", {{"beta", beta}}, six_d}), six_d);
+    for (const FusionTrial& t : trials) sum += fusion_metric(score_fusion(t, {"", "madgwick", {{"beta", beta}}, six_d}), six_d);
     if (sum < best) {
       best = sum;
       best_beta = beta;
@@ -110,13 +110,13 @@ double madgwick_tagp_beta(const std::vector<Trial>& trials, bool six_d) {
   return best_beta;
 }
 
-std::string short_name(const std::string& trial) { return trial.substr(0, trial.find('_')); }
+std::string trial_number(const std::string& trial) { return trial.substr(0, trial.find('_')); }
 
 int bench_fusion(const std::string& data, const std::string& out_dir, bool grid) {
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<Trial> trials;
+  std::vector<FusionTrial> trials;
   try {
-    trials = load_trials(data);
+    trials = load_broad_trials(data);
   } catch (const std::exception& e) {
     std::cerr << "posefair bench fusion: " << e.what() << "\n";
     return exit_code(ErrorKind::NoInput);
@@ -124,7 +124,7 @@ int bench_fusion(const std::string& data, const std::string& out_dir, bool grid)
   const double beta6 = grid ? madgwick_tagp_beta(trials, true) : 0.12;
   char beta6_label[64];
   std::snprintf(beta6_label, sizeof beta6_label, "Madgwick 6D (β=%.2f)", beta6);
-  const std::vector<Method> methods = {
+  const std::vector<FusionMethod> methods = {
       {"Madgwick (β=0.12)", "madgwick", {{"beta", 0.12}, {"c_code_field", true}}, false},
       {"Mahony (Kp=0.74, Ki=0.0012)", "mahony", {{"kp", 0.74}, {"ki", 0.0012}}, false},
       {"VQF", "vqf", {}, false},
@@ -135,7 +135,7 @@ int bench_fusion(const std::string& data, const std::string& out_dir, bool grid)
 
   std::vector<std::vector<OrientationRmse>> results(trials.size());
   for (std::size_t i = 0; i < trials.size(); ++i)
-    for (const Method& m : methods) results[i].push_back(score(trials[i], m));
+    for (const FusionMethod& m : methods) results[i].push_back(score_fusion(trials[i], m));
 
   fs::create_directories(out_dir);
   std::ofstream csv(fs::path(out_dir) / "fusion-trials.csv");
@@ -143,7 +143,7 @@ int bench_fusion(const std::string& data, const std::string& out_dir, bool grid)
   for (std::size_t i = 0; i < trials.size(); ++i)
     for (std::size_t j = 0; j < methods.size(); ++j) {
       const auto published = kPublishedMadgwick.find(trials[i].name);
-      csv << short_name(trials[i].name) << ",\"" << methods[j].label << "\"," << (methods[j].six_d ? "6D" : "9D") << ','
+      csv << trial_number(trials[i].name) << ",\"" << methods[j].label << "\"," << (methods[j].six_d ? "6D" : "9D") << ','
           << results[i][j].total_deg << ',' << results[i][j].heading_deg << ',' << results[i][j].inclination_deg << ','
           << (published != kPublishedMadgwick.end() ? std::to_string(published->second) : "") << "\n";
     }
@@ -151,17 +151,17 @@ int bench_fusion(const std::string& data, const std::string& out_dir, bool grid)
   const auto table = [&](bool six_d) {
     std::printf("## %s\n\n| trial |%s", six_d ? "6D: inclination RMSE (°)" : "9D: total RMSE (°)",
                 six_d ? "" : " BROAD's Madgwick |");
-    for (const Method& m : methods)
+    for (const FusionMethod& m : methods)
       if (m.six_d == six_d) std::printf(" %s |", m.label.c_str());
     std::printf("\n|---|%s", six_d ? "" : "---|");
-    for (const Method& m : methods)
+    for (const FusionMethod& m : methods)
       if (m.six_d == six_d) std::printf("---|");
     std::printf("\n");
     std::vector<double> sums(methods.size(), 0.0);
     double published_sum = 0.0;
     std::size_t published_n = 0;
     for (std::size_t i = 0; i < trials.size(); ++i) {
-      std::printf("| %s |", short_name(trials[i].name).c_str());
+      std::printf("| %s |", trial_number(trials[i].name).c_str());
       if (!six_d) {
         const auto p = kPublishedMadgwick.find(trials[i].name);
         if (p != kPublishedMadgwick.end()) {
@@ -174,8 +174,8 @@ int bench_fusion(const std::string& data, const std::string& out_dir, bool grid)
       }
       for (std::size_t j = 0; j < methods.size(); ++j)
         if (methods[j].six_d == six_d) {
-          std::printf(" %.2f |", metric(results[i][j], six_d));
-          sums[j] += metric(results[i][j], six_d);
+          std::printf(" %.2f |", fusion_metric(results[i][j], six_d));
+          sums[j] += fusion_metric(results[i][j], six_d);
         }
       std::printf("\n");
     }
@@ -191,11 +191,11 @@ int bench_fusion(const std::string& data, const std::string& out_dir, bool grid)
 
   // Per group (trials.json), over the trials present.
   std::vector<std::string> group_names;
-  for (const Trial& t : trials)
+  for (const FusionTrial& t : trials)
     for (const std::string& g : t.groups)
       if (std::find(group_names.begin(), group_names.end(), g) == group_names.end()) group_names.push_back(g);
   std::printf("## Per group: mean over the trials present (9D total / 6D inclination, °)\n\n| group | trials |");
-  for (const Method& m : methods) std::printf(" %s |", m.label.c_str());
+  for (const FusionMethod& m : methods) std::printf(" %s |", m.label.c_str());
   std::printf("\n|---|---|");
   for (std::size_t j = 0; j < methods.size(); ++j) std::printf("---|");
   std::printf("\n");
@@ -208,7 +208,7 @@ int bench_fusion(const std::string& data, const std::string& out_dir, bool grid)
     std::printf("| %s | %zu |", g.c_str(), members.size());
     for (std::size_t j = 0; j < methods.size(); ++j) {
       double sum = 0.0;
-      for (std::size_t i : members) sum += metric(results[i][j], methods[j].six_d);
+      for (std::size_t i : members) sum += fusion_metric(results[i][j], methods[j].six_d);
       const double mean = sum / static_cast<double>(members.size());
       std::printf(" %.2f |", mean);
       gcsv << g << ',' << members.size() << ",\"" << methods[j].label << "\"," << (methods[j].six_d ? "6D" : "9D") << ','

@@ -80,15 +80,15 @@ class MadgwickEstimator final : public OrientationEstimator {
   Quat q_nwu_ = Quat::Identity();
 };
 
-constexpr auto kOptions = with_common_estimator_options(std::array<OptionSpec, 2>{{
+constexpr auto kMadgwickOptions = with_common_estimator_options(std::array<OptionSpec, 2>{{
     {"beta", OptionType::Float, "0.12",
      "gain of the gradient step, rad/s (BROAD's best common value on its 39 trials)"},
     {"c_code_field", OptionType::Boolean, "false",
      "true: the field reference at half length, as Madgwick's published C code has it (and BROAD's figures)"},
 }});
 
-std::unique_ptr<OrientationEstimator> make(const OptionMap& options) {
-  const OptionReader r(kOptions, options);
+std::unique_ptr<OrientationEstimator> make_madgwick_from_options(const OptionMap& options) {
+  const OptionReader r(kMadgwickOptions, options);
   const double beta = r.real("beta");
   if (!(beta >= 0.0)) throw OptionError("beta", "must be zero or positive");
   return std::make_unique<MadgwickEstimator>(beta, r.boolean("c_code_field") ? 0.5 : 1.0,
@@ -98,6 +98,6 @@ std::unique_ptr<OrientationEstimator> make(const OptionMap& options) {
 }  // namespace
 
 const OrientationEstimatorEntry kMadgwickEstimator{
-    "madgwick", "Madgwick's gradient-descent filter (baseline)", kOptions, make};
+    "madgwick", "Madgwick's gradient-descent filter (baseline)", kMadgwickOptions, make_madgwick_from_options};
 
 }  // namespace posefair

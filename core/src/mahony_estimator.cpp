@@ -38,13 +38,13 @@ class MahonyEstimator final : public OrientationEstimator {
   Vec3 integral_ = Vec3::Zero();
 };
 
-constexpr auto kOptions = with_common_estimator_options(std::array<OptionSpec, 2>{{
+constexpr auto kMahonyOptions = with_common_estimator_options(std::array<OptionSpec, 2>{{
     {"kp", OptionType::Float, "0.74", "proportional gain, rad/s (BROAD's TAGP)"},
     {"ki", OptionType::Float, "0.0012", "integral gain, rad/s² (BROAD's TAGP)"},
 }});
 
-std::unique_ptr<OrientationEstimator> make(const OptionMap& options) {
-  const OptionReader r(kOptions, options);
+std::unique_ptr<OrientationEstimator> make_mahony_from_options(const OptionMap& options) {
+  const OptionReader r(kMahonyOptions, options);
   const double kp = r.real("kp"), ki = r.real("ki");
   if (!(kp >= 0.0)) throw OptionError("kp", "must be zero or positive");
   if (!(ki >= 0.0)) throw OptionError("ki", "must be zero or positive");
@@ -54,6 +54,6 @@ std::unique_ptr<OrientationEstimator> make(const OptionMap& options) {
 }  // namespace
 
 const OrientationEstimatorEntry kMahonyEstimator{
-    "mahony", "Mahony's explicit complementary filter (baseline)", kOptions, make};
+    "mahony", "Mahony's explicit complementary filter (baseline)", kMahonyOptions, make_mahony_from_options};
 
 }  // namespace posefair

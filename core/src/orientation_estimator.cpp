@@ -6,7 +6,7 @@
 namespace posefair {
 
 namespace {
-constexpr double kDegree = M_PI / 180.0;
+constexpr double kEstimatorDegree = M_PI / 180.0;
 }
 
 Quat orientation_from_accel_mag(const Vec3& accel, const Vec3* mag) {
@@ -117,7 +117,7 @@ EstimatorLimits read_estimator_limits(const OptionReader& reader) {
   l.use_mag = reader.boolean("magnetometer");
   const double range = reader.real("gyro_range");
   if (!(range > 0.0)) throw OptionError("gyro_range", "must be positive (deg/s)");
-  l.gyro_range = range * kDegree;
+  l.gyro_range = range * kEstimatorDegree;
   l.max_gap = reader.real("max_gap");
   if (!(l.max_gap > 0.0)) throw OptionError("max_gap", "must be positive (seconds)");
   l.mag_stuck_time = reader.real("mag_stuck_time");

@@ -11,9 +11,9 @@ namespace posefair {
 
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
+constexpr double kVqfDeg = M_PI / 180.0;
 
-double wrap_angle(double a) {
+double wrap_heading(double a) {
   a = std::fmod(a + M_PI, 2.0 * M_PI);
   if (a < 0.0) a += 2.0 * M_PI;
   return a - M_PI;
@@ -23,7 +23,7 @@ class VqfEstimator final : public OrientationEstimator {
  public:
   VqfEstimator(const VqfParameters& p, const EstimatorLimits& limits)
       : OrientationEstimator(limits), p_(p) {
-    const double s0 = p_.bias_sigma_init * kDeg;
+    const double s0 = p_.bias_sigma_init * kVqfDeg;
     p0_ = s0 * s0;
     covariance_ = Eigen::Matrix3d::Identity() * p0_;
   }
@@ -47,9 +47,9 @@ class VqfEstimator final : public OrientationEstimator {
     // bias_forgetting_time (the paper's definition of that parameter); measurement noise chosen so that a steady stream of
     // measurements converges to the standard deviation bias_sigma_{motion,rest}: the steady
     // state of P = (P + V) W / (P + V + W) at P = sigma^2 is W = sigma^2 (sigma^2 + V) / V.
-    process_noise_ = std::pow(0.1 * kDeg, 2) * dt / p_.bias_forgetting_time;
+    process_noise_ = std::pow(0.1 * kVqfDeg, 2) * dt / p_.bias_forgetting_time;
     const auto steady_w = [&](double sigma_deg) {
-      const double s2 = std::pow(sigma_deg * kDeg, 2);
+      const double s2 = std::pow(sigma_deg * kVqfDeg, 2);
       return s2 * (s2 + process_noise_) / process_noise_;
     };
     motion_w_ = steady_w(p_.bias_sigma_motion);
@@ -91,7 +91,7 @@ class VqfEstimator final : public OrientationEstimator {
     if (in.gyro != nullptr) {
       const Vec3& g = *in.gyro;
       const Vec3 lp = rest_gyr_lp_.step(g.array()).matrix();
-      const double th = p_.rest_th_gyr * kDeg;
+      const double th = p_.rest_th_gyr * kVqfDeg;
       if (!gyro_ok || (g - lp).squaredNorm() >= th * th || lp.norm() > th) not_at_rest();
       q_gyr_ = (q_gyr_ * so3::from_rotation_vector((g - bias_) * dt)).normalized();
     } else {
@@ -166,7 +166,7 @@ class VqfEstimator final : public OrientationEstimator {
     const Eigen::Matrix3d k = covariance_ * h.transpose() * s.inverse();
     bias_ += k * e;
     covariance_ -= k * h * covariance_;
-    const double clip = p_.bias_clip * kDeg;
+    const double clip = p_.bias_clip * kVqfDeg;
     bias_ = bias_.cwiseMax(-clip).cwiseMin(clip);
   }
 
@@ -197,12 +197,12 @@ class VqfEstimator final : public OrientationEstimator {
       k_mag_init_ = k_mag_init_ / (k_mag_init_ + 1.0);
       if (k_mag_init_ * p_.tau_mag < dt) k_mag_init_ = 0.0;
     }
-    delta_ = wrap_angle(delta_ + k * wrap_angle(std::atan2(m.x(), m.y()) - delta_));
+    delta_ = wrap_heading(delta_ + k * wrap_heading(std::atan2(m.x(), m.y()) - delta_));
   }
 
   void detect_disturbance(double norm, double dip, double dt) {
     const Eigen::Array2d nd = mag_norm_dip_lp_.step(Eigen::Array2d(norm, dip));
-    const double dip_th = p_.mag_dip_th * kDeg;
+    const double dip_th = p_.mag_dip_th * kVqfDeg;
     const auto agrees = [&](double ref_norm, double ref_dip) {
       return ref_norm > 0.0 && std::abs(nd[0] - ref_norm) < p_.mag_norm_th * ref_norm &&
              std::abs(nd[1] - ref_dip) < dip_th;
@@ -221,7 +221,7 @@ class VqfEstimator final : public OrientationEstimator {
     // A new, steady field seen while the sensor turns becomes the reference (a disturbance
     // cannot stay steady in the sensor's frame and the earth's at once).
     if (agrees(candidate_norm_, candidate_dip_)) {
-      if (rest_gyr_lp_.value().matrix().norm() >= p_.mag_new_min_gyr * kDeg) {
+      if (rest_gyr_lp_.value().matrix().norm() >= p_.mag_new_min_gyr * kVqfDeg) {
         candidate_time_ += dt;
         candidate_norm_ += k_mag_ref_ * (nd[0] - candidate_norm_);
         candidate_dip_ += k_mag_ref_ * (nd[1] - candidate_dip_);
@@ -266,13 +266,13 @@ class VqfEstimator final : public OrientationEstimator {
   bool disturbed_ = false;
 };
 
-struct Field {
+struct VqfField {
   std::string_view key;
   double VqfParameters::*value;
   bool positive;  // must be > 0 (else >= 0)
 };
 
-constexpr Field kFields[] = {
+constexpr VqfField kVqfFields[] = {
     {"tau_acc", &VqfParameters::tau_acc, true},
     {"tau_mag", &VqfParameters::tau_mag, true},
     {"bias_sigma_init", &VqfParameters::bias_sigma_init, true},
@@ -297,7 +297,7 @@ constexpr Field kFields[] = {
     {"mag_rejection_factor", &VqfParameters::mag_rejection_factor, true},
 };
 
-constexpr auto kOptions = with_common_estimator_options(std::array<OptionSpec, 25>{{
+constexpr auto kVqfOptions = with_common_estimator_options(std::array<OptionSpec, 25>{{
     {"tau_acc", OptionType::Float, "3", "s: accelerometer low-pass time constant (inclination)"},
     {"tau_mag", OptionType::Float, "9", "s: magnetometer time constant (heading)"},
     {"motion_bias", OptionType::Boolean, "true", "estimate the gyroscope bias in motion"},
@@ -326,10 +326,10 @@ constexpr auto kOptions = with_common_estimator_options(std::array<OptionSpec, 2
     {"mag_rejection_factor", OptionType::Float, "2", "gain divisor after the rejection time"},
 }});
 
-std::unique_ptr<OrientationEstimator> make(const OptionMap& options) {
-  const OptionReader r(kOptions, options);
+std::unique_ptr<OrientationEstimator> make_vqf_from_options(const OptionMap& options) {
+  const OptionReader r(kVqfOptions, options);
   VqfParameters p;
-  for (const Field& f : kFields) {
+  for (const VqfField& f : kVqfFields) {
     const double v = r.real(f.key);
     if (!(f.positive ? v > 0.0 : v >= 0.0))
       throw OptionError(std::string(f.key), f.positive ? "must be positive" : "must be zero or positive");
@@ -350,6 +350,6 @@ std::unique_ptr<OrientationEstimator> make_vqf_estimator(const VqfParameters& pa
 
 const OrientationEstimatorEntry kVqfEstimator{
     "vqf", "VQF (Laidig & Seel 2023): bias estimation, rest detection, magnetic disturbance rejection",
-    kOptions, make};
+    kVqfOptions, make_vqf_from_options};
 
 }  // namespace posefair

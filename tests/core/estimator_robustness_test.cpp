@@ -17,8 +17,8 @@ using test::ImuRecordingSpec;
 using test::make_synthetic_imu;
 using test::SyntheticImu;
 
-constexpr double kDeg = M_PI / 180.0;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kRobustnessDeg = M_PI / 180.0;
+constexpr double kRobustnessNaN = std::numeric_limits<double>::quiet_NaN();
 
 class EstimatorRobustness : public ::testing::TestWithParam<const char*> {
  protected:
@@ -45,7 +45,7 @@ class EstimatorRobustness : public ::testing::TestWithParam<const char*> {
       EXPECT_TRUE(e.orientation().coeffs().allFinite());
       EXPECT_NEAR(e.orientation().norm(), 1.0, 1e-9);
     }
-    return earth_frame_error(e.orientation(), m.truth.back()).total / kDeg;
+    return earth_frame_error(e.orientation(), m.truth.back()).total / kRobustnessDeg;
   }
 };
 
@@ -53,8 +53,8 @@ TEST_P(EstimatorRobustness, NaNReadingsAreLeftOutAndCounted) {
   const SyntheticImu m = imu();
   auto e = make();
   const double err = run(*e, m, [](Sample& s) {
-    if (s.sequence % 50 == 7) s.gyro.x() = kNaN;
-    if (s.sequence % 50 == 17) s.accel.z() = kNaN;
+    if (s.sequence % 50 == 7) s.gyro.x() = kRobustnessNaN;
+    if (s.sequence % 50 == 17) s.accel.z() = kRobustnessNaN;
     if (s.sequence % 50 == 27) s.mag.y() = std::numeric_limits<double>::infinity();
   });
   EXPECT_EQ(e->state().nonfinite, 3u * (m.samples.size() / 50));
@@ -66,11 +66,11 @@ TEST_P(EstimatorRobustness, ASaturatedGyroscopeIsCountedAndTheEstimateRecovers) 
   const SyntheticImu m = imu(30.0);
   auto e = make({{"gyro_range", 100.0}});  // deg/s, above the synthetic motion (69 deg/s at most)
   const double err = run(*e, m, [](Sample& s) {
-    if (s.time > 10.0 && s.time < 12.0) s.gyro.x() = 100.0 * kDeg;  // pinned at full scale for 2 s
+    if (s.time > 10.0 && s.time < 12.0) s.gyro.x() = 100.0 * kRobustnessDeg;  // pinned at full scale for 2 s
   });
   EXPECT_NEAR(static_cast<double>(e->state().gyro_saturated), 400.0, 1.0);
   EXPECT_TRUE(e->state().gyro_bias.allFinite());
-  EXPECT_LT(e->state().gyro_bias.cwiseAbs().maxCoeff() / kDeg, 0.2);  // the pinned reading taught no bias
+  EXPECT_LT(e->state().gyro_bias.cwiseAbs().maxCoeff() / kRobustnessDeg, 0.2);  // the pinned reading taught no bias
   EXPECT_LT(err, 4.0);
 }
 
@@ -97,7 +97,7 @@ TEST_P(EstimatorRobustness, AnAbsentMagnetometerIsCountedAnd6DGoesOn) {
   std::size_t without = 0;
   for (const Sample& s : m.samples) without += s.time > 5.0 ? 1 : 0;
   EXPECT_EQ(e->state().mag_absent, without);
-  EXPECT_LT(earth_frame_error(e->orientation(), m.truth.back()).inclination / kDeg, 2.0);
+  EXPECT_LT(earth_frame_error(e->orientation(), m.truth.back()).inclination / kRobustnessDeg, 2.0);
 }
 
 TEST_P(EstimatorRobustness, BadTimeStepsAreIgnoredAndCounted) {
@@ -108,10 +108,10 @@ TEST_P(EstimatorRobustness, BadTimeStepsAreIgnoredAndCounted) {
     e->update(m.samples[k], m.dt);
     if (k == 300) e->update(m.samples[k], 0.0);
     if (k == 301) e->update(m.samples[k], -0.01);
-    if (k == 302) e->update(m.samples[k], kNaN);
+    if (k == 302) e->update(m.samples[k], kRobustnessNaN);
   }
   EXPECT_EQ(e->state().bad_time_steps, 3u);
-  EXPECT_LT(earth_frame_error(e->orientation(), m.truth.back()).total / kDeg, 3.0);
+  EXPECT_LT(earth_frame_error(e->orientation(), m.truth.back()).total / kRobustnessDeg, 3.0);
 }
 
 TEST_P(EstimatorRobustness, AGapIsNotIntegratedAndTheEstimateReconverges) {
@@ -128,8 +128,8 @@ TEST_P(EstimatorRobustness, AGapIsNotIntegratedAndTheEstimateReconverges) {
     ++taken;
   }
   EXPECT_EQ(e->state().gaps, 1u);
-  EXPECT_LT(earth_frame_error(e->orientation(), m.truth.back()).inclination / kDeg, 2.0);
-  EXPECT_LT(earth_frame_error(e->orientation(), m.truth.back()).total / kDeg, 5.0);
+  EXPECT_LT(earth_frame_error(e->orientation(), m.truth.back()).inclination / kRobustnessDeg, 2.0);
+  EXPECT_LT(earth_frame_error(e->orientation(), m.truth.back()).total / kRobustnessDeg, 5.0);
 }
 
 TEST_P(EstimatorRobustness, NothingHappensBeforeTheFirstAccelerometerReading) {

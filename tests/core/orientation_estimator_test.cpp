@@ -20,27 +20,27 @@ using test::ImuRecordingSpec;
 using test::make_synthetic_imu;
 using test::SyntheticImu;
 
-constexpr double kDeg = M_PI / 180.0;
+constexpr double kEstimatorTestDeg = M_PI / 180.0;
 
 // The worst total / inclination error over the samples from `from_seconds` on, in degrees.
-struct WorstError {
+struct WorstSyntheticError {
   double total = 0.0, inclination = 0.0, heading = 0.0;
 };
 
-WorstError run(OrientationEstimator& e, const SyntheticImu& imu, double from_seconds) {
-  WorstError worst;
+WorstSyntheticError run_worst_error(OrientationEstimator& e, const SyntheticImu& imu, double from_seconds) {
+  WorstSyntheticError worst;
   for (std::size_t k = 0; k < imu.samples.size(); ++k) {
     e.update(imu.samples[k], imu.dt);
     if (imu.samples[k].time < from_seconds) continue;
     const OrientationError err = earth_frame_error(e.orientation(), imu.truth[k]);
-    worst.total = std::max(worst.total, err.total / kDeg);
-    worst.inclination = std::max(worst.inclination, err.inclination / kDeg);
-    worst.heading = std::max(worst.heading, err.heading / kDeg);
+    worst.total = std::max(worst.total, err.total / kEstimatorTestDeg);
+    worst.inclination = std::max(worst.inclination, err.inclination / kEstimatorTestDeg);
+    worst.heading = std::max(worst.heading, err.heading / kEstimatorTestDeg);
   }
   return worst;
 }
 
-std::unique_ptr<OrientationEstimator> make(std::string_view name, OptionMap options = {}) {
+std::unique_ptr<OrientationEstimator> make_estimator_for_test(std::string_view name, OptionMap options = {}) {
   return make_orientation_estimator(name, options);
 }
 
@@ -61,9 +61,9 @@ TEST(OrientationEstimator, EveryEstimatorTracksTheTrueOrientationIn9D) {
   const SyntheticImu imu = make_synthetic_imu(spec);
   for (const char* name : {"vqf", "madgwick", "mahony"}) {
     SCOPED_TRACE(name);
-    auto e = make(name);
+    auto e = make_estimator_for_test(name);
     EXPECT_EQ(e->name(), name);
-    const WorstError worst = run(*e, imu, 2.0);
+    const WorstSyntheticError worst = run_worst_error(*e, imu, 2.0);
     EXPECT_LT(worst.total, 3.0);
     EXPECT_TRUE(e->state().initialised);
     EXPECT_EQ(e->state().updates, imu.samples.size());
@@ -78,10 +78,10 @@ TEST(OrientationEstimator, SixDKeepsInclinationAndIgnoresTheMagnetometer) {
   for (Sample& s : rotated_field.samples) s.mag = Vec3(s.mag.z(), -s.mag.x(), s.mag.y());
   for (const char* name : {"vqf", "madgwick", "mahony"}) {
     SCOPED_TRACE(name);
-    auto a = make(name, {{"magnetometer", false}});
-    auto b = make(name, {{"magnetometer", false}});
-    EXPECT_LT(run(*a, imu, 2.0).inclination, 2.0);
-    run(*b, rotated_field, 0.0);
+    auto a = make_estimator_for_test(name, {{"magnetometer", false}});
+    auto b = make_estimator_for_test(name, {{"magnetometer", false}});
+    EXPECT_LT(run_worst_error(*a, imu, 2.0).inclination, 2.0);
+    run_worst_error(*b, rotated_field, 0.0);
     EXPECT_EQ(a->orientation().coeffs(), b->orientation().coeffs());
     EXPECT_EQ(a->state().mag_absent, 0u);  // 6D by choice is not a missing magnetometer
   }
@@ -91,27 +91,27 @@ TEST(OrientationEstimator, VqfEstimatesTheGyroscopeBiasAtRest) {
   ImuRecordingSpec spec;
   spec.seconds = 12.0;
   spec.rest_seconds = 12.0;
-  spec.gyro_bias = Vec3(0.6, -0.4, 0.3) * kDeg;
+  spec.gyro_bias = Vec3(0.6, -0.4, 0.3) * kEstimatorTestDeg;
   spec.gyro_noise = 0.002;
   const SyntheticImu imu = make_synthetic_imu(spec);
-  auto e = make("vqf");
-  run(*e, imu, 0.0);
+  auto e = make_estimator_for_test("vqf");
+  run_worst_error(*e, imu, 0.0);
   EXPECT_TRUE(e->state().at_rest);
-  EXPECT_LT((e->state().gyro_bias - spec.gyro_bias).norm() / kDeg, 0.05);
-  EXPECT_LT(e->state().bias_sigma / kDeg, 0.1);
+  EXPECT_LT((e->state().gyro_bias - spec.gyro_bias).norm() / kEstimatorTestDeg, 0.05);
+  EXPECT_LT(e->state().bias_sigma / kEstimatorTestDeg, 0.1);
 }
 
 TEST(OrientationEstimator, VqfEstimatesTheGyroscopeBiasInMotionAndIsMoreAccurateForIt) {
   ImuRecordingSpec spec;
   spec.seconds = 60.0;
-  spec.gyro_bias = Vec3(0.8, -0.6, 0.5) * kDeg;
+  spec.gyro_bias = Vec3(0.8, -0.6, 0.5) * kEstimatorTestDeg;
   spec.gyro_noise = 0.003;
   spec.accel_noise = 0.05;
   const SyntheticImu imu = make_synthetic_imu(spec);
-  auto with = make("vqf", {{"magnetometer", false}});
-  auto without = make("vqf", {{"magnetometer", false}, {"motion_bias", false}, {"rest_bias", false}});
-  const double err_with = run(*with, imu, 40.0).inclination;
-  const double err_without = run(*without, imu, 40.0).inclination;
+  auto with = make_estimator_for_test("vqf", {{"magnetometer", false}});
+  auto without = make_estimator_for_test("vqf", {{"magnetometer", false}, {"motion_bias", false}, {"rest_bias", false}});
+  const double err_with = run_worst_error(*with, imu, 40.0).inclination;
+  const double err_without = run_worst_error(*without, imu, 40.0).inclination;
   EXPECT_FALSE(with->state().at_rest);
   const Vec3 error = with->state().gyro_bias - spec.gyro_bias;
   EXPECT_LT(error.norm(), 0.5 * spec.gyro_bias.norm());  // learned in motion, without rest
@@ -127,8 +127,8 @@ TEST(OrientationEstimator, VqfRejectsAMagneticDisturbanceThatMadgwickFollows) {
   for (std::size_t k = 0; k < imu.samples.size(); ++k)
     if (imu.samples[k].time >= 25.0 && imu.samples[k].time < 32.0)
       imu.samples[k].mag += imu.truth[k].conjugate() * Vec3(30.0, 0.0, 0.0);
-  auto vqf = make("vqf");
-  auto madgwick = make("madgwick");
+  auto vqf = make_estimator_for_test("vqf");
+  auto madgwick = make_estimator_for_test("madgwick");
   bool disturbed_seen = false;
   double vqf_worst = 0.0, madgwick_worst = 0.0;
   for (std::size_t k = 0; k < imu.samples.size(); ++k) {
@@ -136,8 +136,8 @@ TEST(OrientationEstimator, VqfRejectsAMagneticDisturbanceThatMadgwickFollows) {
     madgwick->update(imu.samples[k], imu.dt);
     if (imu.samples[k].time >= 26.0 && imu.samples[k].time < 32.0) disturbed_seen |= vqf->state().mag_disturbed;
     if (imu.samples[k].time < 25.0) continue;
-    vqf_worst = std::max(vqf_worst, earth_frame_error(vqf->orientation(), imu.truth[k]).heading / kDeg);
-    madgwick_worst = std::max(madgwick_worst, earth_frame_error(madgwick->orientation(), imu.truth[k]).heading / kDeg);
+    vqf_worst = std::max(vqf_worst, earth_frame_error(vqf->orientation(), imu.truth[k]).heading / kEstimatorTestDeg);
+    madgwick_worst = std::max(madgwick_worst, earth_frame_error(madgwick->orientation(), imu.truth[k]).heading / kEstimatorTestDeg);
   }
   EXPECT_TRUE(disturbed_seen);
   EXPECT_FALSE(vqf->state().mag_disturbed);  // over once the magnet is gone
@@ -156,14 +156,14 @@ TEST(OrientationEstimatorRegistry, ListsBuildsAndJudgesOptions) {
     EXPECT_NE(e->make({}), nullptr);
   }
   try {
-    make("kalman");
+    make_estimator_for_test("kalman");
     ADD_FAILURE() << "no error for an unknown estimator";
   } catch (const std::invalid_argument& e) {
     EXPECT_THAT(e.what(), HasSubstr("unknown estimator 'kalman' (known: madgwick, mahony, vqf)"));
   }
   const auto key_of = [](std::string_view name, OptionMap options) -> std::string {
     try {
-      make(name, std::move(options));
+      make_estimator_for_test(name, std::move(options));
     } catch (const OptionError& e) {
       return e.key();
     }

@@ -15,9 +15,9 @@ namespace {
 using ::testing::HasSubstr;
 
 // BROAD trial 07, rows 782-891: 10 without optical data, then 100 tracked (tests/data/broad/README.md).
-const std::string kBroad = POSEFAIR_SOURCE_DIR "/tests/data/broad/07_undisturbed_fast_rotation_B.csv";
+const std::string kBroadImuExcerpt = POSEFAIR_SOURCE_DIR "/tests/data/broad/07_undisturbed_fast_rotation_B.csv";
 
-std::string error_of(const std::string& text) {
+std::string imu_error_of(const std::string& text) {
   try {
     parse_imu_csv(text, "imu.csv");
   } catch (const PoseFileError& e) {
@@ -27,7 +27,7 @@ std::string error_of(const std::string& text) {
 }
 
 TEST(ImuCsv, ReadsTheBroadExcerptIntoRawSamples) {
-  const ImuRecording rec = read_imu_csv(kBroad);
+  const ImuRecording rec = read_imu_csv(kBroadImuExcerpt);
   ASSERT_EQ(rec.samples.size(), 110u);
   EXPECT_TRUE(rec.has_mag_column);
   EXPECT_TRUE(rec.has_reference_column);
@@ -82,18 +82,18 @@ TEST(ImuCsv, AMissingReadingClearsOnlyItsFlag) {
 }
 
 TEST(ImuCsv, BadInputNamesTheLine) {
-  EXPECT_THAT(error_of("t,qw,qx,qy,qz\n0,1,0,0,0\n"), HasSubstr("imu.csv:1: missing columns"));
-  EXPECT_THAT(error_of("t,gyr_x,gyr_y,acc_x,acc_y,acc_z\n"), HasSubstr("incomplete column set gyr_"));
-  EXPECT_THAT(error_of("t,gyr_x_rads,gyr_y_rads,gyr_z_dps,acc_x,acc_y,acc_z\n"),
+  EXPECT_THAT(imu_error_of("t,qw,qx,qy,qz\n0,1,0,0,0\n"), HasSubstr("imu.csv:1: missing columns"));
+  EXPECT_THAT(imu_error_of("t,gyr_x,gyr_y,acc_x,acc_y,acc_z\n"), HasSubstr("incomplete column set gyr_"));
+  EXPECT_THAT(imu_error_of("t,gyr_x_rads,gyr_y_rads,gyr_z_dps,acc_x,acc_y,acc_z\n"),
               HasSubstr("different units"));
-  EXPECT_THAT(error_of("t,gyr_x_furlong,gyr_y_furlong,gyr_z_furlong,acc_x,acc_y,acc_z\n"),
+  EXPECT_THAT(imu_error_of("t,gyr_x_furlong,gyr_y_furlong,gyr_z_furlong,acc_x,acc_y,acc_z\n"),
               HasSubstr("unknown unit 'furlong'"));
   const std::string header = "t,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z\n";
-  EXPECT_THAT(error_of(header + "0,1,2,3,4,5,6\n1,1,2,x,4,5,6\n"),
+  EXPECT_THAT(imu_error_of(header + "0,1,2,3,4,5,6\n1,1,2,x,4,5,6\n"),
               HasSubstr("imu.csv:3: field 4 (gyr_z) 'x' is not a number"));
-  EXPECT_THAT(error_of(header + "0,1,2,3,4,5\n"), HasSubstr("imu.csv:2: expected 7 fields"));
-  EXPECT_THAT(error_of(header + "1,1,2,3,4,5,6\n0,1,2,3,4,5,6\n"), HasSubstr("imu.csv:3: time goes backwards"));
-  EXPECT_THAT(error_of(header), HasSubstr("no samples"));
+  EXPECT_THAT(imu_error_of(header + "0,1,2,3,4,5\n"), HasSubstr("imu.csv:2: expected 7 fields"));
+  EXPECT_THAT(imu_error_of(header + "1,1,2,3,4,5,6\n0,1,2,3,4,5,6\n"), HasSubstr("imu.csv:3: time goes backwards"));
+  EXPECT_THAT(imu_error_of(header), HasSubstr("no samples"));
 }
 
 }  // namespace

@@ -24,18 +24,18 @@ using testing::run_posefair;
 using testing::ScratchDir;
 using testing::write_text;
 
-const std::string kBroad = POSEFAIR_SOURCE_DIR "/tests/data/broad/07_undisturbed_fast_rotation_B.csv";
-constexpr double kDeg = M_PI / 180.0;
+const std::string kBroadFuseExcerpt = POSEFAIR_SOURCE_DIR "/tests/data/broad/07_undisturbed_fast_rotation_B.csv";
+constexpr double kFuseTestDeg = M_PI / 180.0;
 
 TEST(FuseCommand, FusesTheBroadExcerptCloseToTheOpticalReference) {
   ScratchDir dir;
   const auto out = dir / "fused.txt";
-  const auto r = run_posefair("fuse " + q(kBroad) + " -o " + q(out), dir);
+  const auto r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(out), dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("fused 110 samples"));
   EXPECT_THAT(r.out, HasSubstr("0 non-finite"));
   const PoseSequence fused = formats::read_pose_file(out, {}).poses();
-  const formats::ImuRecording rec = formats::read_imu_csv(kBroad);
+  const formats::ImuRecording rec = formats::read_imu_csv(kBroadFuseExcerpt);
   ASSERT_EQ(fused.size(), rec.samples.size());
   // The sensor rests here: the estimate levels at once; against the optical reference the
   // inclination is off by the IMU-to-marker misalignment only.
@@ -45,13 +45,13 @@ TEST(FuseCommand, FusesTheBroadExcerptCloseToTheOpticalReference) {
     if (!rec.samples[k].has_orientation()) continue;
     worst = std::max(worst, earth_frame_error(fused.orientation[k], rec.samples[k].orientation).inclination);
   }
-  EXPECT_LT(worst / kDeg, 1.5);
+  EXPECT_LT(worst / kFuseTestDeg, 1.5);
 }
 
 TEST(FuseCommand, OtherEstimators6DOptionsAndCsvOutput) {
   ScratchDir dir;
   const auto out = dir / "fused.csv";
-  const auto r = run_posefair("fuse " + q(kBroad) + " -o " + q(out) + " -e madgwick --6d --set beta=0.05", dir);
+  const auto r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(out) + " -e madgwick --6d --set beta=0.05", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("with madgwick (6D)"));
   std::ifstream in(out);
@@ -64,19 +64,19 @@ TEST(FuseCommand, OtherEstimators6DOptionsAndCsvOutput) {
 TEST(FuseCommand, BadInputIsRefusedWithItsReason) {
   ScratchDir dir;
   const auto out = dir / "o.txt";
-  auto r = run_posefair("fuse " + q(kBroad) + " -o " + q(out) + " -e kalman", dir);
+  auto r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(out) + " -e kalman", dir);
   EXPECT_EQ(r.exit_code, 64);
   EXPECT_THAT(r.err, HasSubstr("unknown estimator 'kalman'; known: madgwick mahony vqf"));
-  r = run_posefair("fuse " + q(kBroad) + " -o " + q(out) + " --set bogus=1", dir);
+  r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(out) + " --set bogus=1", dir);
   EXPECT_EQ(r.exit_code, 64);
   EXPECT_THAT(r.err, HasSubstr("vqf has no option 'bogus'"));
-  r = run_posefair("fuse " + q(kBroad) + " -o " + q(out) + " -e madgwick --set beta=fast", dir);
+  r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(out) + " -e madgwick --set beta=fast", dir);
   EXPECT_EQ(r.exit_code, 64);
   EXPECT_THAT(r.err, HasSubstr("beta=fast: not a number"));
-  r = run_posefair("fuse " + q(kBroad) + " -o " + q(out) + " --set tau_acc=-1", dir);
+  r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(out) + " --set tau_acc=-1", dir);
   EXPECT_EQ(r.exit_code, 64);
   EXPECT_THAT(r.err, HasSubstr("tau_acc: must be positive"));
-  r = run_posefair("fuse " + q(kBroad) + " -o " + q(dir / "o.bvh"), dir);
+  r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(dir / "o.bvh"), dir);
   EXPECT_EQ(r.exit_code, 64);
   r = run_posefair("fuse " + q(dir / "absent.csv") + " -o " + q(out), dir);
   EXPECT_EQ(r.exit_code, 66);
@@ -112,13 +112,13 @@ TEST(CalibrateCommand, WritesACalibrationThatFuseApplies) {
   const MagnetometerCalibration c = formats::read_magnetometer_calibration(cal);
   EXPECT_LT((c.offset - Vec3(15.0, -4.0, 22.0)).norm(), 1e-6);
   EXPECT_LT(c.residual_rms, 1e-6);
-  const auto f = run_posefair("fuse " + q(kBroad) + " -o " + q(dir / "o.txt") + " --mag-calibration " + q(cal), dir);
+  const auto f = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(dir / "o.txt") + " --mag-calibration " + q(cal), dir);
   EXPECT_EQ(f.exit_code, 0) << f.err;
 }
 
 TEST(CalibrateCommand, RefusesTooLittleMotion) {
   ScratchDir dir;
-  const auto r = run_posefair("calibrate " + q(kBroad) + " -o " + q(dir / "mag.txt"), dir);  // the sensor rests
+  const auto r = run_posefair("calibrate " + q(kBroadFuseExcerpt) + " -o " + q(dir / "mag.txt"), dir);  // the sensor rests
   EXPECT_EQ(r.exit_code, 65);
   EXPECT_THAT(r.err, HasSubstr("turn the sensor"));
   EXPECT_FALSE(std::filesystem::exists(dir / "mag.txt"));
@@ -141,7 +141,7 @@ TEST(BenchFusionCommand, ScoresATrialPerTrialAndPerGroup) {
                  "trials": {"07_undisturbed_fast_rotation_B": {"groups": ["all_trials", "fast"]},
                             "99_not_in_this_data_set": {"groups": ["all_trials"]}}})");
   // The excerpt with its movement flag set, so its tracked rows are scored.
-  std::ifstream in(kBroad);
+  std::ifstream in(kBroadFuseExcerpt);
   std::string line, text;
   while (std::getline(in, line)) text += (text.empty() ? line : line.substr(0, line.size() - 1) + "1") + "\n";
   write_text(dir / "data/broad/07_undisturbed_fast_rotation_B.csv", text);
