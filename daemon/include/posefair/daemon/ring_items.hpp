@@ -19,6 +19,7 @@ struct RingSample {
   double time, device_time, receive_time;
   double q[4];  // w x y z
   double p[3];
+  double gyro[3], accel[3], mag[3];  // raw inertial readings, valid with their flags (issue 17)
   std::uint64_t enqueued_ns;  // CLOCK_MONOTONIC when the driver handed it over
 };
 static_assert(std::is_trivially_copyable_v<RingSample>);
@@ -49,6 +50,9 @@ inline RingSample pack(const Sample& s, std::uint64_t enqueued_ns) {
                     s.receive_time,
                     {s.orientation.w(), s.orientation.x(), s.orientation.y(), s.orientation.z()},
                     {s.position.x(), s.position.y(), s.position.z()},
+                    {s.gyro.x(), s.gyro.y(), s.gyro.z()},
+                    {s.accel.x(), s.accel.y(), s.accel.z()},
+                    {s.mag.x(), s.mag.y(), s.mag.z()},
                     enqueued_ns};
 }
 
@@ -62,6 +66,9 @@ inline Sample unpack(const RingSample& r) {
   s.receive_time = r.receive_time;
   s.orientation = Quat(r.q[0], r.q[1], r.q[2], r.q[3]);
   s.position = Vec3(r.p[0], r.p[1], r.p[2]);
+  s.gyro = Vec3(r.gyro[0], r.gyro[1], r.gyro[2]);
+  s.accel = Vec3(r.accel[0], r.accel[1], r.accel[2]);
+  s.mag = Vec3(r.mag[0], r.mag[1], r.mag[2]);
   return s;
 }
 
