@@ -1,9 +1,12 @@
-# `posefair bench quality` and `posefair bench latency` (docs/benchmarks.md).
+# `posefair bench quality`, `posefair bench latency` and `posefair bench fusion` (docs/benchmarks.md).
 target_sources(posefair_cli PRIVATE
   ${CMAKE_CURRENT_SOURCE_DIR}/bench_quality_command.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/bench_latency_command.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/bench_fusion_command.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/quality_datasets.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/quality_scoring.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/quality_configurations.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/quality_tuning.cpp)
+find_package(nlohmann_json REQUIRED)  # BROAD's trials.json (bench fusion)
+target_link_libraries(posefair_cli PRIVATE nlohmann_json::nlohmann_json)
 posefair_register_command(bench)

@@ -1,6 +1,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bench_command.hpp"
+#include "bench_fusion_command.hpp"
 #include "bench_latency_command.hpp"
 
 #include <algorithm>
@@ -538,6 +539,7 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   quality->add_flag("--quick", *quick, "synthetic data only, shorter, fewer seeds (seconds, for tests)");
   quality->callback([=, &exit_code] { exit_code = bench_quality(*data, *out, *quick); });
   add_bench_latency_command(*bench, exit_code);
+  add_bench_fusion_command(*bench, exit_code);
 }
 
 }  // namespace posefair::tools

@@ -22,6 +22,7 @@ packages=(
   zlib1g-dev             # CRC-32 of the sample log (drivers)
   libserialport-dev      # the serial driver: ports by path or USB id, settings (drivers)
   libnlopt-cxx-dev       # the quaternion spline optimiser (core)
+  nlohmann-json3-dev     # BROAD's trials.json (posefair bench fusion)
   libgpiod-dev           # GPIO data-ready and scope lines, libgpiod 1.6 (drivers)
 )
 # The hw tests' VM (tests/hw/vm/): Debian's own kernel under qemu, gpio-sim built against its

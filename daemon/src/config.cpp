@@ -20,6 +20,7 @@
 #include <utility>
 
 #include "posefair/core/engine_setting.hpp"
+#include "posefair/core/orientation_estimator.hpp"
 #include "posefair/core/sample_gate.hpp"
 #include "posefair/daemon/output_encoder.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
@@ -133,7 +134,7 @@ constexpr std::string_view kEngineKeys[] = {
     "window",   "window_time", "max_window", "lag", "horizon", "order", "solver", "iterations", "smoothing", "smoothing_r",
     "smoothing_t", "cutoff_hz", "rate_hz", "continuity", "lambda_r", "lambda_t", "variant",
     "epsilon_r", "epsilon_t", "bound",  "gap",       "gap_intervals", "unit_tolerance"};
-constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "overflow", "driver", "engine", "spline", "gpio"};
+constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "overflow", "driver", "engine", "spline", "gpio", "fusion"};
 constexpr std::string_view kGpioKeys[] = {"chip",          "data_ready_line", "edge",        "bias",         "tolerance_min",
                                           "tolerance_max", "output_line",     "output_mode", "heartbeat_hz", "reconnect_min",
                                           "reconnect_max"};
@@ -215,6 +216,11 @@ const ProtocolKind& hid_protocols() {
 }
 const ProtocolKind& output_encodings() {
   static const ProtocolKind kind{"encoding", true, '\'', protocol_infos(output_encoder_entries()), "encoding", "output"};
+  return kind;
+}
+const ProtocolKind& orientation_estimators() {
+  static const ProtocolKind kind{"estimator", true, '\'', protocol_infos(posefair::orientation_estimator_entries()),
+                                 "estimator", "fusion stage"};
   return kind;
 }
 
@@ -1134,6 +1140,7 @@ class Parser {
     if (const toml::node* n = t.get("engine")) local = parse_engine(table_of(*n, key("engine"), "[stream.engine]"), key("engine"));
     s.engine = build_engine(global, local ? &*local : nullptr, driver_rate, t, prefix, s.name);
     if (const toml::node* n = t.get("spline")) s.spline = parse_spline(table_of(*n, key("spline"), "[stream.spline]"), key("spline"));
+    if (const toml::node* n = t.get("fusion")) s.fusion = parse_fusion(table_of(*n, key("fusion"), "[stream.fusion]"), key("fusion"));
     if (const toml::node* n = t.get("gpio")) {
       std::optional<Given<double>> rate = local && local->rate_hz ? local->rate_hz : driver_rate ? driver_rate : global.rate_hz;
       s.gpio = parse_gpio(table_of(*n, key("gpio"), "[stream.gpio]"), key("gpio"), rate);
@@ -1206,6 +1213,27 @@ class Parser {
       g.heartbeat_hz = get_float(*n, key("heartbeat_hz"), FloatRange{0.0, true, 10000.0, false});
     }
     return g;
+  }
+
+  // [stream.fusion]: an estimator (registry name, default the first: vqf) and its options,
+  // type-checked here and judged by the estimator itself, as an output's encoding is.
+  FusionConfig parse_fusion(const toml::table& t, const std::string& prefix) const {
+    const toml::node* name_node = t.get("estimator");
+    const posefair::OrientationEstimatorEntry* entry = posefair::orientation_estimator_entries().front();
+    if (name_node != nullptr) {
+      std::vector<Choice<const posefair::OrientationEstimatorEntry*>> choices;
+      for (const posefair::OrientationEstimatorEntry* e : posefair::orientation_estimator_entries()) choices.push_back({e->name, e});
+      entry = get_choice<const posefair::OrientationEstimatorEntry*>(*name_node, join_key(prefix, "estimator"), choices);
+    }
+    std::vector<std::string_view> known{"estimator"};
+    for (std::string_view k : orientation_estimators().all_keys())
+      if (std::find(known.begin(), known.end(), k) == known.end()) known.push_back(k);
+    check_keys(t, prefix, known);
+    FusionConfig f;
+    f.estimator = std::string(entry->name);
+    const OptionsGiven given = parse_options(t, prefix, orientation_estimators(), f.estimator, f.options);
+    judge_options(t, prefix, given, name_node, join_key(prefix, "estimator"), [&] { entry->make(f.options); });
+    return f;
   }
 
   SplineConfig parse_spline(const toml::table& t, const std::string& prefix) const {

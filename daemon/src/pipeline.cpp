@@ -18,6 +18,7 @@
 #include "posefair/core/fixed_rate_resampler.hpp"
 #include "posefair/core/gap_bridge.hpp"
 #include "posefair/daemon/driver_factory.hpp"
+#include "posefair/daemon/fusion_stage.hpp"
 #include "posefair/daemon/publisher.hpp"
 #include "posefair/daemon/ring_items.hpp"
 #include "posefair/daemon/spsc_ring.hpp"
@@ -39,6 +40,43 @@ std::filesystem::path expand_time_pattern(const std::filesystem::path& path) {
 }
 
 // The engine's state through relaxed atomics: written by the engine thread, read for reports.
+void store_fusion_state(StreamCounters::Fusion& f, const EstimatorState& e, std::uint64_t waiting) {
+  constexpr auto relaxed = std::memory_order_relaxed;
+  f.waiting.store(waiting, relaxed);
+  f.updates.store(e.updates, relaxed);
+  f.initialised.store(e.initialised, relaxed);
+  f.nonfinite.store(e.nonfinite, relaxed);
+  f.gyro_saturated.store(e.gyro_saturated, relaxed);
+  f.mag_stuck.store(e.mag_stuck, relaxed);
+  f.mag_absent.store(e.mag_absent, relaxed);
+  f.bad_time_steps.store(e.bad_time_steps, relaxed);
+  f.gaps.store(e.gaps, relaxed);
+  f.state_resets.store(e.state_resets, relaxed);
+  f.at_rest.store(e.at_rest, relaxed);
+  f.mag_disturbed.store(e.mag_disturbed, relaxed);
+  f.bias_x.store(e.gyro_bias.x(), relaxed);
+  f.bias_y.store(e.gyro_bias.y(), relaxed);
+  f.bias_z.store(e.gyro_bias.z(), relaxed);
+}
+
+EstimatorState load_fusion_state(const StreamCounters::Fusion& f) {
+  constexpr auto relaxed = std::memory_order_relaxed;
+  EstimatorState e;
+  e.initialised = f.initialised.load(relaxed);
+  e.updates = f.updates.load(relaxed);
+  e.nonfinite = f.nonfinite.load(relaxed);
+  e.gyro_saturated = f.gyro_saturated.load(relaxed);
+  e.mag_stuck = f.mag_stuck.load(relaxed);
+  e.mag_absent = f.mag_absent.load(relaxed);
+  e.bad_time_steps = f.bad_time_steps.load(relaxed);
+  e.gaps = f.gaps.load(relaxed);
+  e.state_resets = f.state_resets.load(relaxed);
+  e.at_rest = f.at_rest.load(relaxed);
+  e.mag_disturbed = f.mag_disturbed.load(relaxed);
+  e.gyro_bias = Vec3(f.bias_x.load(relaxed), f.bias_y.load(relaxed), f.bias_z.load(relaxed));
+  return e;
+}
+
 void store_engine_state(StreamCounters& c, const EngineState& e) {
   constexpr auto relaxed = std::memory_order_relaxed;
   c.engine_rate_hz.store(e.rate_hz, relaxed);
@@ -109,6 +147,7 @@ struct Pipeline::Stream final : drivers::SampleSink {
       grid.resize(resampler->max_outputs());
     }
     if (record) record_ring = std::make_unique<SpscRing<RingSample>>(owner.config_.recorder.ring_capacity, OverflowPolicy::DropNewest);
+    if (c.fusion) fusion.emplace(*c.fusion);  // its options were accepted at load
   }
 
   // Driver thread: hand the sample over (stamped), to the recorder too.
@@ -136,6 +175,7 @@ struct Pipeline::Stream final : drivers::SampleSink {
   std::vector<Sample> bridged;                  // engine scratch
   std::optional<FixedRateResampler> resampler;  // engine thread only; [stream.spline] publish_rate_hz
   std::vector<FairedPose> grid;                 // engine scratch
+  std::optional<FusionStage> fusion;            // engine thread only; [stream.fusion]
   StreamCounters counters;
   MadeGpioLines gpio;                           // [stream.gpio]: data-ready sink (driver thread), output line
   std::atomic<bool> driver_running{false};
@@ -288,8 +328,11 @@ bool Pipeline::window_push(Stream& s, const Sample& sample, std::uint64_t enqueu
   return any;
 }
 
-// Engine thread: one sample from the driver, through the gap bridge when there is one.
-bool Pipeline::fair(Stream& s, const Sample& sample, std::uint64_t enqueued_ns) {
+// Engine thread: one sample from the driver, through the fusion stage and the gap bridge when
+// the stream has them.
+bool Pipeline::fair(Stream& s, const Sample& raw, std::uint64_t enqueued_ns) {
+  Sample sample = raw;
+  if (s.fusion && !s.fusion->apply(sample)) return false;
   if (!s.bridge) return window_push(s, sample, enqueued_ns);
   bool any = false;
   const std::size_t n = s.bridge->push(sample, s.bridged);
@@ -324,10 +367,10 @@ void Pipeline::engine_loop() {
         any = true;
         if (hooks_.before_engine_sample) hooks_.before_engine_sample(s.config.id);
         const Sample sample = unpack(r);
-        // A raw-only sample's quaternion is a placeholder, not a measurement: until a fusion
-        // stage makes an orientation from its readings it must not reach the window (the
-        // recorder has it already). Counted, and the stream goes on.
-        if (!sample.has_orientation()) {
+        // A raw-only sample's quaternion is a placeholder, not a measurement: without a fusion
+        // stage ([stream.fusion]) to make an orientation from its readings it must not reach
+        // the window (the recorder has it already). Counted, and the stream goes on.
+        if (!sample.has_orientation() && !s.fusion) {
           s.counters.raw_unfused.fetch_add(1, std::memory_order_relaxed);
           continue;
         }
@@ -354,6 +397,7 @@ void Pipeline::engine_loop() {
         s.counters.bridged_gaps.store(s.bridge->counters().gaps, std::memory_order_relaxed);
         s.counters.bridged_samples.store(s.bridge->counters().samples, std::memory_order_relaxed);
       }
+      if (s.fusion) store_fusion_state(s.counters.fusion, s.fusion->state(), s.fusion->waiting());
       if (s.bridge || s.resampler)
         s.counters.lerp_fallbacks.store((s.bridge ? s.bridge->counters().lerp_fallbacks : 0) +
                                             (s.resampler ? s.resampler->lerp_fallbacks() : 0),
@@ -453,6 +497,10 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.resampled = get(s.counters.resampled);
     st.matrix_lerp = s.config.spline.pose_interpolation == PoseInterpolation::MatrixLerp;
     st.lerp_fallbacks = get(s.counters.lerp_fallbacks);
+    if (s.fusion) {
+      st.fusion = load_fusion_state(s.counters.fusion);
+      st.fusion_waiting = get(s.counters.fusion.waiting);
+    }
     out.push_back(std::move(st));
   }
   return out;

@@ -116,6 +116,18 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
       std::snprintf(buf, sizeof buf, ", lerp fallbacks %" PRIu64, s.lerp_fallbacks);
       lines.back() += buf;
     }
+    if (s.fusion) {
+      const EstimatorState& f = *s.fusion;
+      constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
+      std::snprintf(buf, sizeof buf,
+                    ", fusion: gyro bias (%.3f %.3f %.3f) deg/s, %s, %s, waiting %" PRIu64 ", non-finite %" PRIu64
+                    ", gyro saturated %" PRIu64 ", mag stuck %" PRIu64 ", mag absent %" PRIu64 ", bad steps %" PRIu64
+                    ", gaps %" PRIu64,
+                    f.gyro_bias.x() * kDegPerRad, f.gyro_bias.y() * kDegPerRad, f.gyro_bias.z() * kDegPerRad,
+                    f.at_rest ? "at rest" : "moving", f.mag_disturbed ? "field disturbed" : "field undisturbed",
+                    s.fusion_waiting, f.nonfinite, f.gyro_saturated, f.mag_stuck, f.mag_absent, f.bad_time_steps, f.gaps);
+      lines.back() += buf;
+    }
     lines.back() += engine_text(s.engine);
     if (s.device) lines.back() += device_text(*s.device);
     lines.back() += gpio_text(s.data_ready, s.gpio_output);
@@ -146,6 +158,12 @@ std::string status_line(const std::vector<StreamStats>& now, const std::vector<S
     if (s.device) {
       std::snprintf(buf, sizeof buf, "%s outages %" PRIu64 " bad %" PRIu64, s.device->connected ? "" : " DISCONNECTED",
                     s.device->outages, s.device->bad_frames);
+      out += buf;
+    }
+    // A fusion stage: at rest or moving, and a magnetic disturbance being rejected.
+    if (s.fusion) {
+      std::snprintf(buf, sizeof buf, " imu %s%s", s.fusion->at_rest ? "rest" : "moving",
+                    s.fusion->mag_disturbed ? " MAG-DISTURBED" : "");
       out += buf;
     }
     // A data-ready line that is not held means unpaired (receive-timed) samples.

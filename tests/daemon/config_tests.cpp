@@ -586,6 +586,40 @@ velocity = "central"
   EXPECT_EQ(s.spline.velocity.estimator, geometric_splines::KnotVelocityEstimator::CentralDifference);
 }
 
+TEST(Config, TheFusionTableNamesAnEstimatorAndItsOptions) {
+  const DaemonConfig c = parse_config(R"toml(
+[[stream]]
+id = 1
+name = "poses"
+driver = { type = "synthetic" }
+
+[[stream]]
+id = 2
+name = "imu"
+driver = { type = "synthetic" }
+[stream.fusion]
+estimator = "madgwick"
+beta = 0.05
+magnetometer = false
+
+[[stream]]
+id = 3
+name = "imu-default"
+driver = { type = "synthetic" }
+fusion = { tau_acc = 4 }
+)toml",
+                                      "fusion.toml");
+  ASSERT_EQ(c.streams.size(), 3u);
+  EXPECT_FALSE(c.streams[0].fusion.has_value());
+  ASSERT_TRUE(c.streams[1].fusion.has_value());
+  EXPECT_EQ(c.streams[1].fusion->estimator, "madgwick");
+  EXPECT_EQ(std::get<double>(c.streams[1].fusion->options.at("beta")), 0.05);
+  EXPECT_EQ(std::get<bool>(c.streams[1].fusion->options.at("magnetometer")), false);
+  ASSERT_TRUE(c.streams[2].fusion.has_value());
+  EXPECT_EQ(c.streams[2].fusion->estimator, "vqf");  // the registry's first
+  EXPECT_EQ(std::get<double>(c.streams[2].fusion->options.at("tau_acc")), 4.0);  // an integer taken as a float
+}
+
 TEST(Config, PoseInterpolationIsTheSplineUnlessMatrixLerpIsChosen) {
   const DaemonConfig c = parse_config(R"toml(
 [[stream]]
@@ -1449,6 +1483,41 @@ id = 1
 name = "a"
 driver = { type = "hid", device = "/dev/hidraw0", protocol = "hid-sensor", reconnect_min = 2, reconnect_max = 1 }
 )", "stream[1].driver.reconnect_max: must be >= reconnect_min (2 s), got 1", 4},
+    {"fusion: unknown estimator", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.fusion]
+estimator = "kalman"
+)", "stream[1].fusion.estimator: expected one of 'vqf', 'madgwick', 'mahony', got 'kalman'", 6},
+    {"fusion: another estimator's option", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.fusion]
+estimator = "vqf"
+beta = 0.1
+)", "stream[1].fusion.beta: only for estimator 'madgwick'", 7},
+    {"fusion: a value the estimator refuses", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.fusion]
+tau_acc = 0.0
+)", "stream[1].fusion.tau_acc: must be positive", 6},
+    {"fusion: wrong type", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+fusion = { magnetometer = "yes" }
+)", "stream[1].fusion.magnetometer: ", 5},
+    {"fusion: unknown key", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[stream.fusion]
+estimater = "vqf"
+)", "stream[1].fusion.estimater: unknown key", 6},
     {"spline: a rate of zero", R"([[stream]]
 id = 1
 name = "a"

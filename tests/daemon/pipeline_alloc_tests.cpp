@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <chrono>
 #include <cstddef>
@@ -24,6 +25,7 @@
 #include <vector>
 
 #include "posefair/daemon/config.hpp"
+#include "posefair/daemon/fusion_stage.hpp"
 #include "posefair/daemon/pipeline.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/formats/sample_log.hpp"
@@ -277,6 +279,40 @@ TEST_F(PipelineAllocation, MatrixLerpBridgingAndResamplingAllocateNothingOnTheRe
 // The negative control: JSON lines allocate a string per pose on the publisher thread, so the
 // slots do count those threads' allocations. Which slot is which thread is not known: one of
 // them (the publisher's) allocated, the other (the engine's) still did not.
+// [stream.fusion]: the stage runs on the engine thread, so an estimator update must not
+// allocate. The stage is driven here directly, on this thread, so that every estimator and
+// the bad input it counts (NaN, a gap, a stuck magnetometer) are covered; the whole pipeline
+// with a fusion stage: pipeline_tests' RawSamplesWithAFusionStage...
+TEST_F(PipelineAllocation, TheFusionStageAllocatesNothingPerSample) {
+  for (const char* estimator : {"vqf", "madgwick", "mahony"}) {
+    SCOPED_TRACE(estimator);
+    FusionStage stage(FusionConfig{estimator, {}});
+    std::vector<Sample> samples(4000);
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      const double t = 0.005 * static_cast<double>(k);
+      Sample& s = samples[k];
+      s.time = k >= 2000 ? t + 1.0 : t;  // one gap of a second
+      s.gyro = Vec3(std::sin(t), 0.5 * std::cos(t), 0.2);
+      s.accel = Vec3(0.3 * std::sin(t), 0.2, 9.8);
+      s.mag = k >= 3000 && k < 3400 ? Vec3(1.0, 20.0, -40.0) : Vec3(std::cos(t), 20.0, -40.0);  // stuck for 2 s
+      if (k % 97 == 0) s.gyro.y() = std::nan("");
+      s.flags = kHasGyro | kHasAccel | kHasMag | kNoOrientation;
+    }
+    Sample first = samples[0];
+    stage.apply(first);  // any lazy set-up happens here, outside the count
+    const std::size_t before = counting::thread_allocations();
+    for (std::size_t k = 1; k < samples.size(); ++k) {
+      Sample s = samples[k];
+      stage.apply(s);
+    }
+    EXPECT_EQ(counting::thread_allocations() - before, 0u);
+    EXPECT_GT(stage.state().nonfinite, 0u);
+    EXPECT_GT(stage.state().mag_stuck, 0u);
+    EXPECT_EQ(stage.state().gaps, 1u);
+    EXPECT_EQ(stage.state().bad_time_steps, 0u);
+  }
+}
+
 TEST_F(PipelineAllocation, AJsonOutputAllocatesOnThePublisherThreadOnly) {
   const PipelineRun run = run_pipeline(replay_driver(), "linear", "json");
   std::printf("%s\n", describe(run).c_str());

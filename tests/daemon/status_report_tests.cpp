@@ -78,6 +78,29 @@ TEST(StatusReport, CounterLineAndStatusCarryTheEngineAdaptation) {
   EXPECT_NE(fixed[0].find(", rotation fixed: cutoff 5 Hz (mu 100), position adapted: noise 2.5 units"), std::string::npos) << fixed[0];
 }
 
+TEST(StatusReport, AFusionStageAddsItsBiasRestDisturbanceAndCounters) {
+  StreamStats s = stream(1, "imu", 2000);
+  EXPECT_EQ(counter_lines({s}, {}, 0.0)[0].find("fusion"), std::string::npos);
+  EstimatorState f;
+  f.gyro_bias = Vec3(0.01, -0.02, 0.005);  // rad/s
+  f.at_rest = true;
+  f.mag_disturbed = true;
+  f.nonfinite = 3;
+  f.gyro_saturated = 4;
+  f.mag_stuck = 5;
+  f.mag_absent = 6;
+  f.bad_time_steps = 7;
+  f.gaps = 8;
+  s.fusion = f;
+  s.fusion_waiting = 2;
+  const std::string line = counter_lines({s}, {}, 0.0)[0];
+  EXPECT_NE(line.find(", fusion: gyro bias (0.573 -1.146 0.286) deg/s, at rest, field disturbed, waiting 2, non-finite 3, "
+                      "gyro saturated 4, mag stuck 5, mag absent 6, bad steps 7, gaps 8"),
+            std::string::npos)
+      << line;
+  EXPECT_NE(status_line({s}, {}, 1.0).find(" imu rest MAG-DISTURBED"), std::string::npos) << status_line({s}, {}, 1.0);
+}
+
 TEST(StatusReport, CounterLineCarriesEveryDeviceCounter) {
   StreamStats s = stream(1, "head", 2000);
   s.device = link(true);

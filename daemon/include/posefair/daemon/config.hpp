@@ -174,6 +174,13 @@ struct GpioConfig {
   double reconnect_max = 2.0;  // s, >= reconnect_min
 };
 
+// [stream.fusion] (docs/fusion.md): the stream's raw inertial samples (kNoOrientation) become
+// orientation samples, on the engine thread, before the fairing engine.
+struct FusionConfig {
+  std::string estimator = "vqf";  // a registered orientation estimator
+  posefair::OptionMap options;    // its options, type-checked and accepted by it at load
+};
+
 struct StreamConfig {
   std::uint32_t id = 0;           // unique; the wire protocol's stream id
   std::string name;               // unique, non-empty; for logs, STATUS= and the recording's stream table
@@ -186,6 +193,7 @@ struct StreamConfig {
   WindowConfig engine;
   SplineConfig spline;
   std::optional<GpioConfig> gpio;
+  std::optional<FusionConfig> fusion;
 };
 
 struct OutputConfig {

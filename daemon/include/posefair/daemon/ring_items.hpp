@@ -19,7 +19,7 @@ struct RingSample {
   double time, device_time, receive_time;
   double q[4];  // w x y z
   double p[3];
-  double g[3], a[3], m[3];  // raw gyro, accel, mag (kHasGyro, kHasAccel, kHasMag): for the recorder
+  double gyro[3], accel[3], mag[3];  // raw inertial readings, valid with their flags (issue 17)
   std::uint64_t enqueued_ns;  // CLOCK_MONOTONIC when the driver handed it over
 };
 static_assert(std::is_trivially_copyable_v<RingSample>);
@@ -66,9 +66,9 @@ inline Sample unpack(const RingSample& r) {
   s.receive_time = r.receive_time;
   s.orientation = Quat(r.q[0], r.q[1], r.q[2], r.q[3]);
   s.position = Vec3(r.p[0], r.p[1], r.p[2]);
-  s.gyro = Vec3(r.g[0], r.g[1], r.g[2]);
-  s.accel = Vec3(r.a[0], r.a[1], r.a[2]);
-  s.mag = Vec3(r.m[0], r.m[1], r.m[2]);
+  s.gyro = Vec3(r.gyro[0], r.gyro[1], r.gyro[2]);
+  s.accel = Vec3(r.accel[0], r.accel[1], r.accel[2]);
+  s.mag = Vec3(r.mag[0], r.mag[1], r.mag[2]);
   return s;
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "posefair/core/fairing_window.hpp"
+#include "posefair/core/orientation_estimator.hpp"
 #include "posefair/daemon/latency_histogram.hpp"
 #include "posefair/drivers/driver.hpp"
 #include "posefair/drivers/gpio_data_ready.hpp"
@@ -41,6 +42,17 @@ struct StreamCounters {
   std::atomic<double> engine_rate_hz{0.0};
   std::atomic<int> engine_window{0};
   Channel rotation, position;
+  // [stream.fusion]: the estimator's state and counters (EstimatorState), written by the
+  // engine thread after each batch.
+  struct Fusion {
+    std::atomic<std::uint64_t> waiting{0};  // raw samples before the first accelerometer reading
+    std::atomic<std::uint64_t> updates{0};  // samples the estimator took
+    std::atomic<std::uint64_t> nonfinite{0}, gyro_saturated{0}, mag_stuck{0}, mag_absent{0}, bad_time_steps{0},
+        gaps{0}, state_resets{0};
+    std::atomic<bool> initialised{false}, at_rest{false}, mag_disturbed{false};
+    std::atomic<double> bias_x{0.0}, bias_y{0.0}, bias_z{0.0};  // rad/s
+  };
+  Fusion fusion;
 };
 
 // A consistent-enough copy for reporting (each field read once, relaxed).
@@ -61,6 +73,8 @@ struct StreamStats {
   std::optional<drivers::DeviceHealth> device;  // the device link, for drivers that have one
   std::optional<drivers::GpioDataReadyCounters> data_ready;  // [stream.gpio] data_ready_line
   std::optional<drivers::GpioOutputCounters> gpio_output;    // [stream.gpio] output_line
+  std::optional<EstimatorState> fusion;                      // [stream.fusion]
+  std::uint64_t fusion_waiting = 0;                          // raw samples before its first accelerometer reading
   // Poses lost on the way to subscribers: overflow of the engine's and the publisher's rings.
   std::uint64_t dropped() const { return ring_dropped + publish_dropped; }
 };

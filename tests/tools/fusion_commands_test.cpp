@@ -1,0 +1,158 @@
+// posefair fuse, calibrate and bench fusion end to end: the real binary on the BROAD excerpt
+// (tests/data/broad) and on hand-made recordings, and every bad-input case.
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "cli_runner.hpp"
+#include "posefair/core/orientation_error.hpp"
+#include "posefair/formats/imu_csv.hpp"
+#include "posefair/formats/magnetometer_calibration_file.hpp"
+#include "posefair/formats/pose_file.hpp"
+
+namespace posefair {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::q;
+using testing::run_posefair;
+using testing::ScratchDir;
+using testing::write_text;
+
+const std::string kBroadFuseExcerpt = POSEFAIR_SOURCE_DIR "/tests/data/broad/07_undisturbed_fast_rotation_B.csv";
+constexpr double kFuseTestDeg = M_PI / 180.0;
+
+TEST(FuseCommand, FusesTheBroadExcerptCloseToTheOpticalReference) {
+  ScratchDir dir;
+  const auto out = dir / "fused.txt";
+  const auto r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(out), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("fused 110 samples"));
+  EXPECT_THAT(r.out, HasSubstr("0 non-finite"));
+  const PoseSequence fused = formats::read_pose_file(out, {}).poses();
+  const formats::ImuRecording rec = formats::read_imu_csv(kBroadFuseExcerpt);
+  ASSERT_EQ(fused.size(), rec.samples.size());
+  // The sensor rests here: the estimate levels at once; against the optical reference the
+  // inclination is off by the IMU-to-marker misalignment only.
+  double worst = 0.0;
+  for (std::size_t k = 0; k < fused.size(); ++k) {
+    EXPECT_DOUBLE_EQ(fused.time[k], rec.samples[k].time);
+    if (!rec.samples[k].has_orientation()) continue;
+    worst = std::max(worst, earth_frame_error(fused.orientation[k], rec.samples[k].orientation).inclination);
+  }
+  EXPECT_LT(worst / kFuseTestDeg, 1.5);
+}
+
+TEST(FuseCommand, OtherEstimators6DOptionsAndCsvOutput) {
+  ScratchDir dir;
+  const auto out = dir / "fused.csv";
+  const auto r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(out) + " -e madgwick --6d --set beta=0.05", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("with madgwick (6D)"));
+  std::ifstream in(out);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, "t,qw,qx,qy,qz");
+  EXPECT_EQ(formats::read_pose_file(out, {}).poses().size(), 110u);
+}
+
+TEST(FuseCommand, BadInputIsRefusedWithItsReason) {
+  ScratchDir dir;
+  const auto out = dir / "o.txt";
+  auto r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(out) + " -e kalman", dir);
+  EXPECT_EQ(r.exit_code, 64);
+  EXPECT_THAT(r.err, HasSubstr("unknown estimator 'kalman'; known: madgwick mahony vqf"));
+  r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(out) + " --set bogus=1", dir);
+  EXPECT_EQ(r.exit_code, 64);
+  EXPECT_THAT(r.err, HasSubstr("vqf has no option 'bogus'"));
+  r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(out) + " -e madgwick --set beta=fast", dir);
+  EXPECT_EQ(r.exit_code, 64);
+  EXPECT_THAT(r.err, HasSubstr("beta=fast: not a number"));
+  r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(out) + " --set tau_acc=-1", dir);
+  EXPECT_EQ(r.exit_code, 64);
+  EXPECT_THAT(r.err, HasSubstr("tau_acc: must be positive"));
+  r = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(dir / "o.bvh"), dir);
+  EXPECT_EQ(r.exit_code, 64);
+  r = run_posefair("fuse " + q(dir / "absent.csv") + " -o " + q(out), dir);
+  EXPECT_EQ(r.exit_code, 66);
+  write_text(dir / "poses.csv", "t,qw,qx,qy,qz\n0,1,0,0,0\n");
+  r = run_posefair("fuse " + q(dir / "poses.csv") + " -o " + q(out), dir);
+  EXPECT_EQ(r.exit_code, 65);
+  EXPECT_THAT(r.err, HasSubstr("poses.csv:1: missing columns"));
+}
+
+// A recording whose magnetometer has a known hard- and soft-iron distortion.
+std::filesystem::path distorted_recording(const ScratchDir& dir) {
+  std::mt19937 rng(9);
+  std::normal_distribution<double> n;
+  std::string text = "t_s,gyr_x_rads,gyr_y_rads,gyr_z_rads,acc_x_ms2,acc_y_ms2,acc_z_ms2,mag_x_uT,mag_y_uT,mag_z_uT\n";
+  for (int k = 0; k < 300; ++k) {
+    const Vec3 f = Vec3(n(rng), n(rng), n(rng)).normalized() * 45.0;
+    const Vec3 m(1.2 * f.x() + 15.0, 0.9 * f.y() - 4.0, f.z() + 0.1 * f.x() + 22.0);
+    std::ostringstream line;
+    line.precision(17);
+    line << 0.01 * k << ",0,0,0,0,0,9.81," << m.x() << ',' << m.y() << ',' << m.z() << "\n";
+    text += line.str();
+  }
+  write_text(dir / "turning.csv", text);
+  return dir / "turning.csv";
+}
+
+TEST(CalibrateCommand, WritesACalibrationThatFuseApplies) {
+  ScratchDir dir;
+  const auto cal = dir / "mag.txt";
+  const auto r = run_posefair("calibrate " + q(distorted_recording(dir)) + " -o " + q(cal), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("300 magnetometer readings"));
+  const MagnetometerCalibration c = formats::read_magnetometer_calibration(cal);
+  EXPECT_LT((c.offset - Vec3(15.0, -4.0, 22.0)).norm(), 1e-6);
+  EXPECT_LT(c.residual_rms, 1e-6);
+  const auto f = run_posefair("fuse " + q(kBroadFuseExcerpt) + " -o " + q(dir / "o.txt") + " --mag-calibration " + q(cal), dir);
+  EXPECT_EQ(f.exit_code, 0) << f.err;
+}
+
+TEST(CalibrateCommand, RefusesTooLittleMotion) {
+  ScratchDir dir;
+  const auto r = run_posefair("calibrate " + q(kBroadFuseExcerpt) + " -o " + q(dir / "mag.txt"), dir);  // the sensor rests
+  EXPECT_EQ(r.exit_code, 65);
+  EXPECT_THAT(r.err, HasSubstr("turn the sensor"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "mag.txt"));
+  EXPECT_EQ(run_posefair("calibrate " + q(dir / "absent.csv") + " -o " + q(dir / "mag.txt"), dir).exit_code, 66);
+}
+
+TEST(BenchFusionCommand, SaysWhereTheDataIsWhenItIsMissing) {
+  ScratchDir dir;
+  const auto r = run_posefair("bench fusion --data " + q(dir.path()), dir);
+  EXPECT_EQ(r.exit_code, 66);
+  EXPECT_THAT(r.err, HasSubstr("broad/trials.json not found; it comes from BROAD"));
+  EXPECT_THAT(r.err, HasSubstr("POSEFAIR_DATA"));
+}
+
+TEST(BenchFusionCommand, ScoresATrialPerTrialAndPerGroup) {
+  ScratchDir dir;
+  std::filesystem::create_directories(dir / "data/broad");
+  write_text(dir / "data/broad/trials.json",
+             R"({"groups": [{"name": "all_trials"}, {"name": "fast"}],
+                 "trials": {"07_undisturbed_fast_rotation_B": {"groups": ["all_trials", "fast"]},
+                            "99_not_in_this_data_set": {"groups": ["all_trials"]}}})");
+  // The excerpt with its movement flag set, so its tracked rows are scored.
+  std::ifstream in(kBroadFuseExcerpt);
+  std::string line, text;
+  while (std::getline(in, line)) text += (text.empty() ? line : line.substr(0, line.size() - 1) + "1") + "\n";
+  write_text(dir / "data/broad/07_undisturbed_fast_rotation_B.csv", text);
+  const auto r = run_posefair("bench fusion --data " + q(dir / "data") + " -o " + q(dir / "out"), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("# BROAD: 1 trials"));
+  EXPECT_THAT(r.out, HasSubstr("| 07 | 5.00 |"));  // BROAD's published Madgwick figure beside ours
+  EXPECT_THAT(r.out, HasSubstr("| fast | 1 |"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "out/fusion-trials.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "out/fusion-groups.csv"));
+}
+
+}  // namespace
+}  // namespace posefair
