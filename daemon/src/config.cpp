@@ -1268,6 +1268,29 @@ class Parser {
              "no spline); remove it, or use pose_interpolation = 'spline'");
   }
 
+  // [[output]] destinations: at least one; a destination without a port gets the encoding's
+  // default port (its client's usual one).
+  std::vector<Endpoint> parse_destinations(const toml::table& t, const std::string& prefix, const OutputEncoderEntry& encoding) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    std::vector<Endpoint> out;
+    const toml::node& dest_node = require(t, "destinations", prefix);
+    if (!dest_node.is_array()) wrong_type(dest_node, key("destinations"), "an array of strings");
+    const toml::array& dests = *dest_node.as_array();
+    if (dests.empty()) fail(dest_node, key("destinations"), "must list at least one destination");
+    for (std::size_t i = 0; i < dests.size(); ++i) {
+      const std::string k = element_key(key("destinations"), i);
+      const std::string text = get_string(dests[i], k);
+      const std::optional<Endpoint> e = Endpoint::parse(text, encoding.default_port != 0 ? encoding.default_port : kDefaultPort);
+      if (!e)
+        fail(dests[i], k, "not a destination: " + in_quotes(text) +
+                              "; expected a numeric IPv4 or IPv6 address with an optional port, e.g. '239.255.0.1:5700' or '[::1]:5700'");
+      if (e->port() == 0) fail(dests[i], k, "port 0 is not a destination: " + in_quotes(text));
+      if (e->is_unspecified()) fail(dests[i], k, "the unspecified address is not a destination: " + in_quotes(text));
+      out.push_back(*e);
+    }
+    return out;
+  }
+
   OutputConfig parse_output(const toml::node& node, const std::string& prefix, const std::vector<StreamConfig>& streams) const {
     const toml::table& t = table_of(node, prefix, "[[output]]");
     auto key = [&](std::string_view name) { return join_key(prefix, name); };
@@ -1288,20 +1311,13 @@ class Parser {
     posefair::OptionMap options;
     const OptionsGiven given = parse_options(t, prefix, output_encodings(), std::string(encoding->name), options);
 
-    const toml::node& dest_node = require(t, "destinations", prefix);
-    if (!dest_node.is_array()) wrong_type(dest_node, key("destinations"), "an array of strings");
-    const toml::array& dests = *dest_node.as_array();
-    if (dests.empty()) fail(dest_node, key("destinations"), "must list at least one destination");
-    for (std::size_t i = 0; i < dests.size(); ++i) {
-      const std::string k = element_key(key("destinations"), i);
-      const std::string text = get_string(dests[i], k);
-      const std::optional<Endpoint> e = Endpoint::parse(text, encoding->default_port != 0 ? encoding->default_port : kDefaultPort);
-      if (!e)
-        fail(dests[i], k, "not a destination: " + in_quotes(text) +
-                              "; expected a numeric IPv4 or IPv6 address with an optional port, e.g. '239.255.0.1:5700' or '[::1]:5700'");
-      if (e->port() == 0) fail(dests[i], k, "port 0 is not a destination: " + in_quotes(text));
-      if (e->is_unspecified()) fail(dests[i], k, "the unspecified address is not a destination: " + in_quotes(text));
-      o.destinations.push_back(*e);
+    if (encoding->own_transport) {
+      // It finds its readers by its own discovery (DDS): the UDP keys would mean nothing.
+      for (std::string_view k : {"destinations", "ttl", "interface", "loopback"})
+        if (const toml::node* n = t.get(k))
+          fail(*n, key(k), "has no meaning with encoding " + in_quotes(encoding->name) + ", which finds its readers by its own discovery");
+    } else {
+      o.destinations = parse_destinations(t, prefix, *encoding);
     }
 
     if (const toml::node* n = t.get("ttl")) o.send.multicast_ttl = static_cast<int>(get_int(*n, key("ttl"), 0, 255));

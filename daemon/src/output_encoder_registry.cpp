@@ -12,6 +12,9 @@ const OutputEncoderEntry& opentrack_output_encoding();   // opentrack_encoder.cp
 const OutputEncoderEntry& freed_output_encoding();       // freed_encoder.cpp: FreeD D1
 const OutputEncoderEntry& vmc_output_encoding();         // vmc_encoder.cpp: VMC over OSC
 const OutputEncoderEntry& vrchat_output_encoding();      // vrchat_encoder.cpp: VRChat OSC trackers
+#ifdef POSEFAIR_WITH_DDS
+const OutputEncoderEntry& dds_output_encoding();         // dds_publisher.cpp: ROS 2 PoseStamped over DDS
+#endif
 
 std::span<const OutputEncoderEntry* const> output_encoder_entries() {
   static const OutputEncoderEntry* const entries[] = {
@@ -21,6 +24,9 @@ std::span<const OutputEncoderEntry* const> output_encoder_entries() {
       &freed_output_encoding(),
       &vmc_output_encoding(),
       &vrchat_output_encoding(),
+#ifdef POSEFAIR_WITH_DDS  // a build with Cyclone DDS (daemon/CMakeLists.txt)
+      &dds_output_encoding(),
+#endif
   };
   return entries;
 }

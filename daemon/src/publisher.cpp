@@ -67,6 +67,10 @@ Publisher::Result Publisher::publish(const RingPose& pose) {
     m.angular_velocity = out.angular_velocity ? rate : std::nullopt;
     const bool with_rate = m.angular_velocity.has_value();
     Encoded& e = encoded_[out.encoded];
+    if (e.encoder->delivers()) {  // its own transport (DDS): no datagram, no destinations
+      if (!e.encoder->deliver(m)) ++result.failures;
+      continue;
+    }
     if (e.size == 0 || e.with_rate != with_rate) {
       e.size = e.encoder->encode(m, e.buffer);
       e.with_rate = with_rate;

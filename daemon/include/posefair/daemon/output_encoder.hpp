@@ -27,6 +27,10 @@ class OutputEncoder {
   // publisher thread for every pose: an encoding meant for the real-time path must not
   // allocate (binary does not; JSON lines, a convenience, does).
   virtual std::size_t encode(const PoseMessage& m, std::span<std::uint8_t> out) const = 0;
+  // An encoding with a transport of its own (DDS) publishes each pose itself: the publisher
+  // calls deliver() instead of encode() and sending, and counts a false as a failed send.
+  virtual bool delivers() const { return false; }
+  virtual bool deliver(const PoseMessage&) const { return false; }
 };
 
 // A stream an output carries, as its encoding may need it: a client names poses by a bone, a
@@ -51,6 +55,8 @@ struct OutputEncoderEntry {
   std::shared_ptr<const OutputEncoder> (*make)(const posefair::OptionMap& options, std::span<const OutputStream> streams);
   // The UDP port a destination without one gets (the client's usual port); 0: posefair's 5700.
   std::uint16_t default_port = 0;
+  // The encoder delivers poses itself (OutputEncoder::delivers): the output has no destinations.
+  bool own_transport = false;
 };
 
 // Every registered encoding, in registration order; the first is the default.
