@@ -23,7 +23,7 @@ namespace {
 using namespace posefair;
 using namespace posefair::daemon;
 
-const OutputStream kStreams[] = {{1, "head"}};
+const std::vector<OutputStream> kStreams = {{1, "head"}};
 
 // Per-encoding options for one stream.
 posefair::OptionMap options_for(std::string_view encoding) {

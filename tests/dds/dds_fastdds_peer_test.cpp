@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -107,7 +108,7 @@ void expect_pose(const geometry_msgs::msg::PoseStamped& s, const std::string& fr
 TEST(DdsFastddsPeer, ReadsTheReliablePoseStampedTopicWithRosNames) {
   const OutputEncoderEntry* entry = find_output_encoder("dds");
   ASSERT_NE(entry, nullptr);
-  const OutputStream streams[] = {{4, "head"}};
+  const std::vector<OutputStream> streams = {{4, "head"}};
   const auto dds = entry->make({{"frame_id", std::string("map")}}, streams);
   FastDdsReader reader(0, "rt/posefair/head/pose", true);
   EXPECT_EQ(reader.type_name(), "geometry_msgs::msg::dds_::PoseStamped_");
@@ -117,7 +118,7 @@ TEST(DdsFastddsPeer, ReadsTheReliablePoseStampedTopicWithRosNames) {
 }
 
 TEST(DdsFastddsPeer, ReadsABestEffortTopicOnAnotherDomainAndPrefix) {
-  const OutputStream streams[] = {{4, "wrist_left"}};
+  const std::vector<OutputStream> streams = {{4, "wrist_left"}};
   const auto dds = find_output_encoder("dds")->make(
       {{"domain_id", std::int64_t{7}}, {"prefix", std::string("rig/a")}, {"qos", std::string("best-effort")}}, streams);
   FastDdsReader reader(7, "rt/rig/a/wrist_left/pose", false);
@@ -164,9 +165,33 @@ TEST(DdsFastddsPeer, PosefairdPublishesAStreamFromItsConfig) {
   }
 }
 
+// A topic that is not a ROS 2 name is a config error: posefaird --check exits 78 with
+// file:line:key, for the prefix and for a stream's name.
+TEST(DdsEncoding, PosefairdRefusesAnInvalidTopicWithFileLineAndKey) {
+  testing::TempDir dir;
+  struct Row {
+    std::string toml, where;
+  };
+  const std::string stream = "[[stream]]\nid = 1\nname = \"%\"\ndriver = { type = \"synthetic\" }\n";
+  auto with_name = [&](const std::string& name) { return stream.substr(0, stream.find('%')) + name + stream.substr(stream.find('%') + 1); };
+  const Row rows[] = {
+      {with_name("head") + "[[output]]\nencoding = \"dds\"\nprefix = \"rig//a\"\n", ":7:10: output[1].prefix: "},
+      {with_name("left-hand") + "[[output]]\nencoding = \"dds\"\n", ":5:1: output[1].streams: "},
+      {with_name("head") + "[[output]]\nencoding = \"dds\"\ndestinations = [\"127.0.0.1\"]\n", ":7:16: output[1].destinations: "},
+  };
+  int n = 0;
+  for (const Row& row : rows) {
+    const std::string config = (dir / ("bad" + std::to_string(++n) + ".toml")).string();
+    std::ofstream(config) << row.toml;
+    testing::Subprocess d({POSEFAIR_BINARY_DIR "/daemon/posefaird", "--check", "-c", config}, dir / "out", dir / "err");
+    EXPECT_EQ(d.wait(20s), 78) << d.err();
+    EXPECT_NE(d.err().find(config + row.where), std::string::npos) << d.err();
+  }
+}
+
 TEST(DdsEncoding, RefusesNamesThatAreNotRosTopics) {
   auto refused = [](const posefair::OptionMap& o, std::string_view stream) -> std::string {
-    const OutputStream streams[] = {{1, stream}};
+    const std::vector<OutputStream> streams = {{1, stream}};
     try {
       (void)find_output_encoder("dds")->make(o, streams);
     } catch (const posefair::OptionError& e) {
