@@ -66,6 +66,28 @@ TEST(ClientFrames, HeadAnglesOfATurnLeftAPitchUpAndALeanRight) {
   EXPECT_NEAR(both.pitch, 25.0, 1e-9);
 }
 
+TEST(ClientFrames, AtStraightUpTheTurnIsAllYaw) {
+  // Gimbal lock: only yaw ± roll is defined; the whole turn goes into yaw (roll 0).
+  const HeadAngles up = head_angles(turn_left(30) * pitch_up(90));
+  EXPECT_NEAR(up.pitch, 90.0, 1e-6);
+  EXPECT_NEAR(up.yaw, 30.0, 1e-6);
+  EXPECT_NEAR(up.roll, 0.0, 1e-6);
+  const std::array<double, 3> e = unity_euler_zxy(unity_rotation(turn_left(30) * pitch_up(90)));
+  EXPECT_NEAR(e[0], -90.0, 1e-6);
+  EXPECT_NEAR(e[1], -30.0, 1e-6);
+  EXPECT_NEAR(e[2], 0.0, 1e-6);
+}
+
+TEST(ClientFrames, HeadAnglesComposeBackToTheRotation) {
+  for (const Quat& q : {Quat(Eigen::AngleAxisd(2.5, Vec3(-0.3, 0.5, 0.8).normalized())),
+                        Quat(Eigen::AngleAxisd(0.4, Vec3(1, 2, -0.5).normalized())), turn_left(179) * lean_right(-170)}) {
+    const HeadAngles a = head_angles(q);
+    EXPECT_LE(std::abs(a.pitch), 90.0);
+    const Quat back = turn_left(a.yaw) * pitch_up(a.pitch) * lean_right(a.roll);
+    EXPECT_NEAR(std::abs(back.dot(q)), 1.0, 1e-12);
+  }
+}
+
 TEST(ClientFrames, UnityShowsATurnLeftAsNegativeYAndAPitchUpAsNegativeX) {
   // Unity: x right, y up, z forward, left-handed; Quaternion.Euler(0, 90, 0) turns to the right.
   const std::array<double, 3> left = unity_euler_zxy(unity_rotation(turn_left(90)));
