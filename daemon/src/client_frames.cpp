@@ -17,6 +17,25 @@ double fold_degrees(double a) {
   return a == -180.0 ? 180.0 : a;
 }
 
+// The Tait–Bryan angles (a, b, c) in degrees of R = R_i(a) R_j(b) R_k(c) (i, j, k distinct axes,
+// 0 = x), the principal solution: b within ±90°, a and c in [-180, 180]. With s = +1 for a cyclic
+// order (xyz, yzx, zxy) and -1 otherwise, R(i,k) = s sin b, (-s R(j,k), R(k,k)) = cos b (sin a,
+// cos a) and (-s R(i,j), R(i,i)) = cos b (sin c, cos c). At b = ±90° only a ± c is defined: c = 0
+// takes it all into a. Closed form, a few trig calls: this runs per pose on the publisher thread.
+std::array<double, 3> principal_tait_bryan(const Quat& q, int i, int j, int k) {
+  const Eigen::Matrix3d r = q.normalized().toRotationMatrix();
+  const double s = ((j - i + 3) % 3 == 1) ? 1.0 : -1.0;
+  const double sin_b = std::clamp(s * r(i, k), -1.0, 1.0);
+  double a = 0.0, c = 0.0;
+  if (std::abs(sin_b) < 1.0 - 1e-12) {
+    a = std::atan2(-s * r(j, k), r(k, k));
+    c = std::atan2(-s * r(i, j), r(i, i));
+  } else {
+    a = std::atan2(s * r(k, j), r(j, j));
+  }
+  return {fold_degrees(a * kToDegrees), std::asin(sin_b) * kToDegrees, fold_degrees(c * kToDegrees)};
+}
+
 }  // namespace
 
 Quat rotation_from_zyx_degrees(double yaw, double pitch, double roll) {
@@ -36,40 +55,16 @@ Quat unity_rotation(const Quat& q) {
 }
 
 std::array<double, 3> unity_euler_zxy(const Quat& unity_q) {
-  // R = Ry(y) Rx(x) Rz(z), so R12 = -sin x, (R02, R22) = cos x (sin y, cos y) and
-  // (R10, R11) = cos x (sin z, cos z); x within ±90°, as Unity's own eulerAngles (up to a turn).
-  // At x = ±90° only y ± z is defined: z = 0 takes it all into y. Closed form, a few trig calls:
-  // this runs per pose on the publisher thread.
-  const Quat q = unity_q.normalized();
-  const double w = q.w(), x = q.x(), y = q.y(), z = q.z();
-  const double r12 = 2.0 * (y * z - w * x);
-  const double ax = std::asin(std::clamp(-r12, -1.0, 1.0));
-  double ay = 0.0, az = 0.0;
-  if (std::abs(r12) < 1.0 - 1e-12) {
-    ay = std::atan2(2.0 * (x * z + w * y), 1.0 - 2.0 * (x * x + y * y));
-    az = std::atan2(2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z));
-  } else {
-    ay = std::atan2(-2.0 * (x * z - w * y), 1.0 - 2.0 * (y * y + z * z));
-  }
-  return {fold_degrees(ax * kToDegrees), fold_degrees(ay * kToDegrees), fold_degrees(az * kToDegrees)};
+  // R = Ry(y) Rx(x) Rz(z): x within ±90°, as Unity's own eulerAngles (up to a turn).
+  const std::array<double, 3> yxz = principal_tait_bryan(unity_q, 1, 0, 2);
+  return {yxz[1], yxz[0], yxz[2]};
 }
 
-HeadAngles head_angles(const Quat& q_in) {
-  // R = Rz(yaw) Ry(b) Rx(roll) with b = -pitch (posefair's +y rotation is nose down, a head's
-  // pitch is up): R20 = -sin b, (R10, R00) = cos b (sin yaw, cos yaw), (R21, R22) = cos b
-  // (sin roll, cos roll). At b = ±90° roll = 0 takes yaw ± roll into yaw.
-  const Quat q = q_in.normalized();
-  const double w = q.w(), x = q.x(), y = q.y(), z = q.z();
-  const double r20 = 2.0 * (x * z - w * y);
-  const double b = std::asin(std::clamp(-r20, -1.0, 1.0));
-  double yaw = 0.0, roll = 0.0;
-  if (std::abs(r20) < 1.0 - 1e-12) {
-    yaw = std::atan2(2.0 * (x * y + w * z), 1.0 - 2.0 * (y * y + z * z));
-    roll = std::atan2(2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y));
-  } else {
-    yaw = std::atan2(-2.0 * (x * y - w * z), 1.0 - 2.0 * (x * x + z * z));
-  }
-  return HeadAngles{fold_degrees(yaw * kToDegrees), fold_degrees(-b * kToDegrees), fold_degrees(roll * kToDegrees)};
+HeadAngles head_angles(const Quat& q) {
+  // R = Rz(yaw) Ry(b) Rx(roll) with b = -pitch: posefair's +y rotation is nose down, a head's
+  // pitch is up.
+  const std::array<double, 3> zyx = principal_tait_bryan(q, 2, 1, 0);
+  return HeadAngles{zyx[0], fold_degrees(-zyx[1]), zyx[2]};
 }
 
 Vec3 opentrack_position_cm(const Vec3& p) { return 100.0 * Vec3(-p.y(), p.z(), -p.x()); }
