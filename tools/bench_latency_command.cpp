@@ -41,11 +41,12 @@ struct LatencyOptions {
   // Also an output of every other registered encoding (opentrack, freed, vmc, vrchat, dds;
   // docs/outputs.md) to a socket nobody reads, to see what enabling them all costs.
   bool all_encodings = false;
+  double client_rate = 0.0;  // > 0: max_rate_hz of those outputs
 };
 
 // The extra [[output]] tables of --all-encodings: every registered encoding but the first (the
 // binary one the receiver reads), with the per-stream keys the client encodings need.
-std::string client_outputs(int streams, std::uint16_t sink_port) {
+std::string client_outputs(int streams, std::uint16_t sink_port, double max_rate_hz) {
   static constexpr const char* kBones[] = {"Hips", "Spine", "Chest", "UpperChest", "Neck", "Head", "LeftShoulder",
                                            "RightShoulder", "LeftUpperArm", "RightUpperArm", "LeftLowerArm",
                                            "RightLowerArm", "LeftHand", "RightHand", "LeftUpperLeg", "RightUpperLeg"};
@@ -54,6 +55,7 @@ std::string client_outputs(int streams, std::uint16_t sink_port) {
   for (const daemon::OutputEncoderEntry* e : daemon::output_encoder_entries().subspan(1)) {
     const std::string name(e->name);
     toml += "[[output]]\nencoding = \"" + name + "\"\n" + (e->own_transport ? "" : to);
+    if (max_rate_hz > 0) toml += "max_rate_hz = " + std::to_string(max_rate_hz) + "\n";
     if (name == "vmc") {  // one bone per stream, at most as many as named here
       std::string ids, bones;
       for (int i = 0; i < std::min<int>(streams, std::size(kBones)); ++i) {
@@ -113,7 +115,7 @@ int bench_latency(const LatencyOptions& o) {
   }
   toml += "[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(port) + "\"]\n";
   daemon::UdpSocket sink = daemon::UdpSocket::bind(*daemon::Endpoint::parse("127.0.0.1:0"));  // read by nobody
-  if (o.all_encodings) toml += client_outputs(o.streams, sink.local_endpoint().port());
+  if (o.all_encodings) toml += client_outputs(o.streams, sink.local_endpoint().port(), o.client_rate);
   daemon::DaemonConfig config;
   try {
     config = daemon::parse_config(toml, "bench-latency.toml");
@@ -215,6 +217,9 @@ void add_bench_latency_command(CLI::App& bench, int& exit_code) {
   cmd->add_flag("--all-encodings", o->all_encodings,
                 "also an output of every other encoding (opentrack, freed, vmc, vrchat, dds) to a socket nobody reads; "
                 "with dds, run it in a network namespace of its own (docs/outputs.md)");
+  cmd->add_option("--client-rate", o->client_rate, "with --all-encodings: their outputs' max_rate_hz (0: every pose)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100000.0));
   cmd->add_flag("--aligned", o->aligned, "all streams sample at the same instant (default: phases spread over the period)");
   cmd->add_option("--ring", o->ring_capacity, "ring capacity per stream (power of two)")->capture_default_str();
   cmd->callback([o, &exit_code] { exit_code = bench_latency(*o); });
