@@ -15,25 +15,16 @@
 #include "posefair/daemon/client_frames.hpp"
 #include "posefair/daemon/output_encoder.hpp"
 #include "posefair/daemon/output_rate_limit.hpp"
+#include "known_rotations.hpp"
 
 namespace posefair::daemon {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
-// posefair's frame: x forward, y left, z up. A turn to the left is +z, a pitch up is -y.
-Quat turn_left(double degrees) { return Quat(Eigen::AngleAxisd(degrees * kDeg, Vec3::UnitZ())); }
-Quat pitch_up(double degrees) { return Quat(Eigen::AngleAxisd(-degrees * kDeg, Vec3::UnitY())); }
-Quat lean_right(double degrees) { return Quat(Eigen::AngleAxisd(degrees * kDeg, Vec3::UnitX())); }
-
-PoseMessage pose(const Quat& q, std::optional<Vec3> p = std::nullopt, std::uint32_t stream = 1) {
-  PoseMessage m;
-  m.stream = stream;
-  m.sample_time = 12.5;
-  m.orientation = q;
-  m.position = p;
-  return m;
-}
+using testing::kDeg;
+using testing::lean_right;
+using testing::pitch_up;
+using testing::pose;
+using testing::turn_left;
 
 std::shared_ptr<const OutputEncoder> make(std::string_view encoding, const posefair::OptionMap& options = {},
                                           std::vector<OutputStream> streams = {{1, "head"}}) {

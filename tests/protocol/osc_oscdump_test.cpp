@@ -18,6 +18,7 @@
 
 #include "posefair/daemon/output_encoder.hpp"
 #include "posefair/daemon/udp_socket.hpp"
+#include "known_rotations.hpp"
 #include "subprocess.hpp"
 
 namespace posefair::testing {
@@ -27,8 +28,6 @@ using namespace std::chrono_literals;
 using daemon::Endpoint;
 using daemon::OutputStream;
 using daemon::PoseMessage;
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 // A UDP port free on this host now (bound to port 0, read, released) for oscdump to take.
 std::uint16_t free_udp_port() {
@@ -98,22 +97,10 @@ std::vector<std::uint8_t> encode(std::string_view encoding, const posefair::Opti
   return buffer;
 }
 
-PoseMessage pose(const Quat& q, std::optional<Vec3> p, std::uint32_t stream) {
-  PoseMessage m;
-  m.stream = stream;
-  m.sample_time = 2.5;
-  m.orientation = q;
-  m.position = p;
-  return m;
-}
-
-Quat turn_left(double degrees) { return Quat(Eigen::AngleAxisd(degrees * kDeg, Vec3::UnitZ())); }
-Quat pitch_up(double degrees) { return Quat(Eigen::AngleAxisd(-degrees * kDeg, Vec3::UnitY())); }
-
 TEST(OscThroughOscdump, VmcRootIsAUnityPoseWithOkAndTime) {
   // 1 m forward, 0.5 m left, 1.5 m up, turned 90° left: Unity (x right, y up, z forward)
   // position (-0.5, 1.5, 1); rotation -90° about Unity's y: (0, -sin 45°, 0, cos 45°).
-  const auto lines = through_oscdump(encode("vmc", {}, {{3, "body"}}, pose(turn_left(90), Vec3(1.0, 0.5, 1.5), 3)), 3);
+  const auto lines = through_oscdump(encode("vmc", {}, {{3, "body"}}, pose(turn_left(90), Vec3(1.0, 0.5, 1.5), 3, 2.5)), 3);
   ASSERT_EQ(lines.size(), 3u);
   EXPECT_EQ(lines[0].path, "/VMC/Ext/Root/Pos");
   EXPECT_EQ(lines[0].types, "sfffffff");
