@@ -5,10 +5,12 @@
 #include <sys/resource.h>
 #include <time.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cinttypes>
 #include <cstdio>
+#include <iterator>
 #include <map>
 #include <string>
 #include <thread>
@@ -36,7 +38,39 @@ struct LatencyOptions {
   // Nobody reads the destination socket (the subscriber is on another machine): the bench then
   // measures the daemon alone, without a receiver thread competing for the same cores.
   bool no_receiver = false;
+  // Also an output of every other registered encoding (opentrack, freed, vmc, vrchat, dds;
+  // docs/outputs.md) to a socket nobody reads, to see what enabling them all costs.
+  bool all_encodings = false;
+  double client_rate = 0.0;  // > 0: max_rate_hz of those outputs
 };
+
+// The extra [[output]] tables of --all-encodings: every registered encoding but the first (the
+// binary one the receiver reads), with the per-stream keys the client encodings need.
+std::string client_outputs(int streams, std::uint16_t sink_port, double max_rate_hz) {
+  static constexpr const char* kBones[] = {"Hips", "Spine", "Chest", "UpperChest", "Neck", "Head", "LeftShoulder",
+                                           "RightShoulder", "LeftUpperArm", "RightUpperArm", "LeftLowerArm",
+                                           "RightLowerArm", "LeftHand", "RightHand", "LeftUpperLeg", "RightUpperLeg"};
+  std::string toml;
+  const std::string to = "destinations = [\"127.0.0.1:" + std::to_string(sink_port) + "\"]\n";
+  for (const daemon::OutputEncoderEntry* e : daemon::output_encoder_entries().subspan(1)) {
+    const std::string name(e->name);
+    toml += "[[output]]\nencoding = \"" + name + "\"\n" + (e->own_transport ? "" : to);
+    if (max_rate_hz > 0) toml += "max_rate_hz = " + std::to_string(max_rate_hz) + "\n";
+    if (name == "vmc") {  // one bone per stream, at most as many as named here
+      std::string ids, bones;
+      for (int i = 0; i < std::min<int>(streams, std::size(kBones)); ++i) {
+        ids += (i ? ", " : "") + std::to_string(i + 1);
+        bones += std::string(i ? ", " : "") + "\"" + kBones[i] + "\"";
+      }
+      toml += "streams = [" + ids + "]\nbones = [" + bones + "]\n";
+    } else if (name == "vrchat") {  // trackers 1 to 8
+      std::string ids;
+      for (int i = 0; i < std::min(streams, 8); ++i) ids += (i ? ", " : "") + std::to_string(i + 1);
+      toml += "streams = [" + ids + "]\n";
+    }
+  }
+  return toml;
+}
 
 double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); }
 
@@ -80,6 +114,8 @@ int bench_latency(const LatencyOptions& o) {
             "\nphase = " + std::to_string(o.aligned ? 0.0 : static_cast<double>(i) / o.streams) + "\n";
   }
   toml += "[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(port) + "\"]\n";
+  daemon::UdpSocket sink = daemon::UdpSocket::bind(*daemon::Endpoint::parse("127.0.0.1:0"));  // read by nobody
+  if (o.all_encodings) toml += client_outputs(o.streams, sink.local_endpoint().port(), o.client_rate);
   daemon::DaemonConfig config;
   try {
     config = daemon::parse_config(toml, "bench-latency.toml");
@@ -109,9 +145,9 @@ int bench_latency(const LatencyOptions& o) {
   });
   if (o.no_receiver) receiver.join();
 
-  std::printf("bench latency: %d streams at %.0f Hz for %.1f s, window %d, lag %d, %s solver, ring %d, realtime priority %d, %s\n",
+  std::printf("bench latency: %d streams at %.0f Hz for %.1f s, window %d, lag %d, %s solver, ring %d, realtime priority %d, %s%s\n",
               o.streams, o.rate, o.duration, o.window, o.lag, o.solver.c_str(), o.ring_capacity, o.realtime_priority,
-              o.aligned ? "phases aligned" : "phases spread");
+              o.aligned ? "phases aligned" : "phases spread", o.all_encodings ? ", every encoding" : "");
   const double cpu0 = process_cpu_seconds();
   const auto t0 = std::chrono::steady_clock::now();
   {
@@ -179,6 +215,12 @@ void add_bench_latency_command(CLI::App& bench, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::Range(0, 99));
   cmd->add_flag("--no-receiver", o->no_receiver, "send to a socket nobody reads (measure the daemon alone)");
+  cmd->add_flag("--all-encodings", o->all_encodings,
+                "also an output of every other encoding (opentrack, freed, vmc, vrchat, dds) to a socket nobody reads; "
+                "with dds, run it in a network namespace of its own (docs/outputs.md)");
+  cmd->add_option("--client-rate", o->client_rate, "with --all-encodings: their outputs' max_rate_hz (0: every pose)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100000.0));
   cmd->add_flag("--aligned", o->aligned, "all streams sample at the same instant (default: phases spread over the period)");
   cmd->add_option("--ring", o->ring_capacity, "ring capacity per stream (power of two)")->capture_default_str();
   cmd->callback([o, &exit_code] { exit_code = bench_latency(*o); });

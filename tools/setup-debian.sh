@@ -24,7 +24,14 @@ packages=(
   libnlopt-cxx-dev       # the quaternion spline optimiser (core)
   nlohmann-json3-dev     # BROAD's trials.json (posefair bench fusion)
   libgpiod-dev           # GPIO data-ready and scope lines, libgpiod 1.6 (drivers)
+  liblo-dev              # OSC bundles of the vmc and vrchat output encodings (daemon)
+  cyclonedds-dev cyclonedds-tools  # the dds output encoding: Cyclone DDS and its idlc (daemon)
 )
+# The client encodings' independent peers (docs/outputs.md): oscdump receives the OSC
+# encodings, a Fast DDS reader (fastddsgen generates its type) the dds one.
+if [[ "${1:-}" == "--tests" ]]; then
+  packages+=(liblo-tools libfastrtps-dev fastddsgen iproute2 util-linux)
+fi
 # The hw tests' VM (tests/hw/vm/): Debian's own kernel under qemu, gpio-sim built against its
 # headers, and the tests' independent peers. Only amd64 boots that kernel.
 if [[ "${1:-}" == "--tests" && $(dpkg --print-architecture) == amd64 ]]; then

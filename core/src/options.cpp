@@ -16,6 +16,7 @@ std::string_view to_string(OptionType type) {
     case OptionType::Boolean: return "a boolean";
     case OptionType::IntegerOrString: return "an integer or a string";
     case OptionType::IntegerArray: return "an array of integers";
+    case OptionType::StringArray: return "an array of strings";
   }
   return "a value";
 }
@@ -45,6 +46,7 @@ bool fits(const OptionValue& v, OptionType type) {
     case OptionType::Float: return std::holds_alternative<double>(v) || std::holds_alternative<std::int64_t>(v);
     case OptionType::Boolean: return std::holds_alternative<bool>(v);
     case OptionType::IntegerArray: return std::holds_alternative<std::vector<std::int64_t>>(v);
+    case OptionType::StringArray: return std::holds_alternative<std::vector<std::string>>(v);
   }
   return false;
 }
@@ -123,6 +125,11 @@ bool OptionReader::boolean(std::string_view key) const {
 
 std::vector<std::int64_t> OptionReader::integers(std::string_view key) const {
   if (const OptionValue* v = given(key)) return std::get<std::vector<std::int64_t>>(*v);
+  throw OptionError(std::string(key), "missing required key");
+}
+
+std::vector<std::string> OptionReader::strings(std::string_view key) const {
+  if (const OptionValue* v = given(key)) return std::get<std::vector<std::string>>(*v);
   throw OptionError(std::string(key), "missing required key");
 }
 

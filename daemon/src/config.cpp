@@ -134,7 +134,8 @@ constexpr std::string_view kEngineKeys[] = {
     "window",   "window_time", "max_window", "lag", "horizon", "order", "solver", "iterations", "smoothing", "smoothing_r",
     "smoothing_t", "cutoff_hz", "rate_hz", "continuity", "lambda_r", "lambda_t", "variant",
     "epsilon_r", "epsilon_t", "bound",  "gap",       "gap_intervals", "unit_tolerance"};
-constexpr std::string_view kStreamKeys[] = {"id", "name", "ring_capacity", "overflow", "driver", "engine", "spline", "gpio", "fusion"};
+constexpr std::string_view kStreamKeys[] = {"id",     "name", "ring_capacity", "overflow", "driver", "engine",
+                                            "spline", "gpio", "fusion",        "mounting", "world"};
 constexpr std::string_view kGpioKeys[] = {"chip",          "data_ready_line", "edge",        "bias",         "tolerance_min",
                                           "tolerance_max", "output_line",     "output_mode", "heartbeat_hz", "reconnect_min",
                                           "reconnect_max"};
@@ -264,7 +265,7 @@ struct ProtocolGiven : OptionsGiven {
 };
 
 constexpr std::string_view kOutputKeys[] = {"encoding", "destinations", "ttl",          "interface",
-                                            "loopback", "streams",      "angular_velocity"};
+                                            "loopback", "streams",      "angular_velocity", "max_rate_hz"};
 constexpr std::string_view kRecorderKeys[] = {"path",  "enabled", "max_file_bytes", "flush_interval",
                                               "overwrite", "sync", "ring_capacity"};
 
@@ -770,6 +771,14 @@ class Parser {
         }
         return values;
       }
+      case OptionType::StringArray: {
+        if (!n.is_array()) wrong_type(n, key, "an array of strings");
+        const toml::array& a = *n.as_array();
+        std::vector<std::string> values;
+        for (std::size_t i = 0; i < a.size(); ++i)  // an integer element is taken as its digits: trackers = [1, 2, "head"]
+          values.push_back(a[i].is_integer() ? std::to_string(a[i].as_integer()->get()) : get_nonempty_string(a[i], element_key(key, i)));
+        return values;
+      }
     }
     wrong_type(n, key, to_string(spec.type));
   }
@@ -1145,7 +1154,24 @@ class Parser {
       std::optional<Given<double>> rate = local && local->rate_hz ? local->rate_hz : driver_rate ? driver_rate : global.rate_hz;
       s.gpio = parse_gpio(table_of(*n, key("gpio"), "[stream.gpio]"), key("gpio"), rate);
     }
+    if (const toml::node* n = t.get("mounting")) s.frame.mounting = get_rotation(*n, key("mounting"));
+    if (const toml::node* n = t.get("world")) s.frame.world = get_rotation(*n, key("world"));
     return s;
+  }
+
+  // A rotation ([[stream]] mounting, world): [yaw, pitch, roll] in degrees about posefair's
+  // z, y, x (R = Rz Ry Rx), or a unit quaternion [w, x, y, z] (norm within 1e-3 of 1).
+  Quat get_rotation(const toml::node& n, const std::string& key) const {
+    if (!n.is_array()) wrong_type(n, key, "an array of 3 angles [yaw, pitch, roll] in degrees or a quaternion [w, x, y, z]");
+    const toml::array& a = *n.as_array();
+    if (a.size() != 3 && a.size() != 4)
+      fail(n, key, "expected [yaw, pitch, roll] in degrees or a quaternion [w, x, y, z], got " + std::to_string(a.size()) + " numbers");
+    double v[4] = {};
+    for (std::size_t i = 0; i < a.size(); ++i) v[i] = get_float(a[i], element_key(key, i), FloatRange{});
+    if (a.size() == 3) return rotation_from_zyx_degrees(v[0], v[1], v[2]);
+    const Quat q(v[0], v[1], v[2], v[3]);
+    if (std::abs(q.norm() - 1.0) > 1e-3) fail(n, key, "a quaternion must have norm 1 (within 1e-3), got " + number(q.norm()));
+    return q.normalized();
   }
 
   // A GPIO line: an offset (integer) or a line name (string).
@@ -1270,6 +1296,29 @@ class Parser {
              "no spline); remove it, or use pose_interpolation = 'spline'");
   }
 
+  // [[output]] destinations: at least one; a destination without a port gets the encoding's
+  // default port (its client's usual one).
+  std::vector<Endpoint> parse_destinations(const toml::table& t, const std::string& prefix, const OutputEncoderEntry& encoding) const {
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    std::vector<Endpoint> out;
+    const toml::node& dest_node = require(t, "destinations", prefix);
+    if (!dest_node.is_array()) wrong_type(dest_node, key("destinations"), "an array of strings");
+    const toml::array& dests = *dest_node.as_array();
+    if (dests.empty()) fail(dest_node, key("destinations"), "must list at least one destination");
+    for (std::size_t i = 0; i < dests.size(); ++i) {
+      const std::string k = element_key(key("destinations"), i);
+      const std::string text = get_string(dests[i], k);
+      const std::optional<Endpoint> e = Endpoint::parse(text, encoding.default_port != 0 ? encoding.default_port : kDefaultPort);
+      if (!e)
+        fail(dests[i], k, "not a destination: " + in_quotes(text) +
+                              "; expected a numeric IPv4 or IPv6 address with an optional port, e.g. '239.255.0.1:5700' or '[::1]:5700'");
+      if (e->port() == 0) fail(dests[i], k, "port 0 is not a destination: " + in_quotes(text));
+      if (e->is_unspecified()) fail(dests[i], k, "the unspecified address is not a destination: " + in_quotes(text));
+      out.push_back(*e);
+    }
+    return out;
+  }
+
   OutputConfig parse_output(const toml::node& node, const std::string& prefix, const std::vector<StreamConfig>& streams) const {
     const toml::table& t = table_of(node, prefix, "[[output]]");
     auto key = [&](std::string_view name) { return join_key(prefix, name); };
@@ -1290,26 +1339,20 @@ class Parser {
     posefair::OptionMap options;
     const OptionsGiven given = parse_options(t, prefix, output_encodings(), std::string(encoding->name), options);
 
-    const toml::node& dest_node = require(t, "destinations", prefix);
-    if (!dest_node.is_array()) wrong_type(dest_node, key("destinations"), "an array of strings");
-    const toml::array& dests = *dest_node.as_array();
-    if (dests.empty()) fail(dest_node, key("destinations"), "must list at least one destination");
-    for (std::size_t i = 0; i < dests.size(); ++i) {
-      const std::string k = element_key(key("destinations"), i);
-      const std::string text = get_string(dests[i], k);
-      const std::optional<Endpoint> e = Endpoint::parse(text, kDefaultPort);
-      if (!e)
-        fail(dests[i], k, "not a destination: " + in_quotes(text) +
-                              "; expected a numeric IPv4 or IPv6 address with an optional port, e.g. '239.255.0.1:5700' or '[::1]:5700'");
-      if (e->port() == 0) fail(dests[i], k, "port 0 is not a destination: " + in_quotes(text));
-      if (e->is_unspecified()) fail(dests[i], k, "the unspecified address is not a destination: " + in_quotes(text));
-      o.destinations.push_back(*e);
+    if (encoding->own_transport) {
+      // It finds its readers by its own discovery (DDS): the UDP keys would mean nothing.
+      for (std::string_view k : {"destinations", "ttl", "interface", "loopback"})
+        if (const toml::node* n = t.get(k))
+          fail(*n, key(k), "has no meaning with encoding " + in_quotes(encoding->name) + ", which finds its readers by its own discovery");
+    } else {
+      o.destinations = parse_destinations(t, prefix, *encoding);
     }
 
     if (const toml::node* n = t.get("ttl")) o.send.multicast_ttl = static_cast<int>(get_int(*n, key("ttl"), 0, 255));
     if (const toml::node* n = t.get("interface")) o.send.interface.name_or_address = get_nonempty_string(*n, key("interface"));
     if (const toml::node* n = t.get("loopback")) o.send.multicast_loopback = get_bool(*n, key("loopback"));
     if (const toml::node* n = t.get("angular_velocity")) o.angular_velocity = get_bool(*n, key("angular_velocity"));
+    if (const toml::node* n = t.get("max_rate_hz")) o.max_rate_hz = get_float(*n, key("max_rate_hz"), kPositive);
     if (const toml::node* n = t.get("streams")) {
       if (!n->is_array()) wrong_type(*n, key("streams"), "an array of stream ids");
       const toml::array& ids = *n->as_array();
@@ -1323,8 +1366,15 @@ class Parser {
         o.streams.push_back(id);
       }
     }
-    // Built once, here: the publisher only calls it.
-    judge_options(t, prefix, given, encoding_node, key("encoding"), [&] { o.encoder = encoding->make(options); });
+    // Built once, here: the publisher only calls it. It learns the streams it carries in the
+    // order the output lists them (all, in config order, when it lists none).
+    std::vector<OutputStream> carried;
+    for (const StreamConfig& s : streams)
+      if (o.streams.empty()) carried.push_back({s.id, s.name});
+    for (std::uint32_t id : o.streams)
+      for (const StreamConfig& s : streams)
+        if (s.id == id) carried.push_back({s.id, s.name});
+    judge_options(t, prefix, given, encoding_node, key("encoding"), [&] { o.encoder = encoding->make(options, carried); });
     return o;
   }
 

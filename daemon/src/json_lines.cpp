@@ -547,7 +547,7 @@ class JsonLinesOutputEncoder final : public OutputEncoder {
 const OutputEncoderEntry& json_lines_output_encoding() {
   static const OutputEncoderEntry entry{
       "json", "JSON lines: one JSON object per datagram, for scripts and debugging", {},
-      [](const posefair::OptionMap& options) -> std::shared_ptr<const OutputEncoder> {
+      [](const posefair::OptionMap& options, std::span<const OutputStream>) -> std::shared_ptr<const OutputEncoder> {
         (void)posefair::OptionReader({}, options);  // it reads none: refuses any
         static const auto encoder = std::make_shared<const JsonLinesOutputEncoder>();
         return encoder;

@@ -188,6 +188,7 @@ Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
     : config_(config), hooks_(std::move(hooks)) {
   const bool record = config_.recorder.enabled;
   std::vector<std::uint32_t> ids;
+  std::vector<StreamFrame> frames;
   for (std::size_t i = 0; i < config_.streams.size(); ++i) {
     const StreamConfig& sc = config_.streams[i];
     // A source that cannot be used is a configuration error at the stream's key.
@@ -211,8 +212,9 @@ Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
       throw Error(ErrorKind::Config, e.what(), stream_key + ".gpio");
     }
     ids.push_back(sc.id);
+    frames.push_back(sc.frame);
   }
-  publisher_ = std::make_unique<Publisher>(session, ids, config_.outputs, first_sequence);
+  publisher_ = std::make_unique<Publisher>(session, ids, config_.outputs, first_sequence, frames);
   if (record && !defer_recorder) {
     formats::SampleLogWriterOptions wo;
     wo.max_file_bytes = config_.recorder.max_file_bytes;

@@ -10,11 +10,12 @@ namespace posefair::daemon {
 
 Publisher::Publisher(std::uint32_t session, std::vector<std::uint32_t> stream_ids,
                      const std::vector<OutputConfig>& outputs,
-                     const std::map<std::uint32_t, std::uint64_t>& first_sequence)
+                     const std::map<std::uint32_t, std::uint64_t>& first_sequence, const std::vector<StreamFrame>& frames)
     : session_(session) {
   streams_.resize(stream_ids.size());
   for (std::size_t i = 0; i < stream_ids.size(); ++i) {
     streams_[i].id = stream_ids[i];
+    if (i < frames.size()) streams_[i].frame = frames[i];
     if (auto it = first_sequence.find(stream_ids[i]); it != first_sequence.end()) streams_[i].next_sequence = it->second;
   }
   outputs_.reserve(outputs.size());
@@ -31,7 +32,8 @@ Publisher::Publisher(std::uint32_t session, std::vector<std::uint32_t> stream_id
       e.buffer.resize(kMaxDatagramSize);
       encoded_.push_back(std::move(e));
     }
-    outputs_.push_back(Output{encoded, oc.angular_velocity, std::move(carries), UdpSender(oc.destinations, oc.send)});
+    outputs_.push_back(Output{encoded, oc.angular_velocity, std::move(carries), UdpSender(oc.destinations, oc.send),
+                              OutputRateLimit(oc.max_rate_hz, stream_ids.size())});
   }
 }
 
@@ -43,8 +45,8 @@ Publisher::Result Publisher::publish(const RingPose& pose) {
   m.stream = st.id;
   m.sequence = st.next_sequence++;
   m.sample_time = pose.time;
-  m.orientation = Quat(pose.q[0], pose.q[1], pose.q[2], pose.q[3]);
-  if (pose.flags & kHasPosition) m.position = Vec3(pose.p[0], pose.p[1], pose.p[2]);
+  m.orientation = st.frame.orientation(Quat(pose.q[0], pose.q[1], pose.q[2], pose.q[3]));
+  if (pose.flags & kHasPosition) m.position = st.frame.position(Vec3(pose.p[0], pose.p[1], pose.p[2]));
   if (pose.flags & kClamped) m.flags |= kFlagClamped;
   if (pose.flags & kBridged) m.flags |= kFlagBridged;
   // Body rate between consecutive emitted poses: q_prev⁻¹ q = exp(ω dt / 2) in the papers'
@@ -61,9 +63,14 @@ Publisher::Result Publisher::publish(const RingPose& pose) {
   for (Output& out : outputs_) {
     if (!out.carries[pose.stream_index]) continue;
     result.carried = true;
+    if (!out.rate_limit.admit(pose.stream_index, pose.time)) continue;
     m.angular_velocity = out.angular_velocity ? rate : std::nullopt;
     const bool with_rate = m.angular_velocity.has_value();
     Encoded& e = encoded_[out.encoded];
+    if (e.encoder->delivers()) {  // its own transport (DDS): no datagram, no destinations
+      if (!e.encoder->deliver(m)) ++result.failures;
+      continue;
+    }
     if (e.size == 0 || e.with_rate != with_rate) {
       e.size = e.encoder->encode(m, e.buffer);
       e.with_rate = with_rate;

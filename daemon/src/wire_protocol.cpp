@@ -187,7 +187,7 @@ class BinaryOutputEncoder final : public OutputEncoder {
 const OutputEncoderEntry& binary_output_encoding() {
   static const OutputEncoderEntry entry{
       "binary", "wire protocol v1: one little-endian binary datagram per pose", {},
-      [](const posefair::OptionMap& options) -> std::shared_ptr<const OutputEncoder> {
+      [](const posefair::OptionMap& options, std::span<const OutputStream>) -> std::shared_ptr<const OutputEncoder> {
         (void)posefair::OptionReader({}, options);  // it reads none: refuses any
         static const auto encoder = std::make_shared<const BinaryOutputEncoder>();
         return encoder;

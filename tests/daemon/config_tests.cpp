@@ -34,6 +34,12 @@ std::string option_text(const posefair::OptionMap& options, const std::string& k
 
 // An expected message with the registries' lists in place of {can-protocols} ("a, b") and
 // {hid-protocols} ("'a', 'b'"), so that a new protocol changes no row.
+std::vector<std::string> encoding_names() {
+  std::vector<std::string> names;
+  for (std::string_view n : output_encoder_names()) names.emplace_back(n);
+  return names;
+}
+
 std::string with_registry_lists(std::string text) {
   const auto join = [](const std::vector<std::string>& names, bool quoted) {
     std::string list;
@@ -41,7 +47,8 @@ std::string with_registry_lists(std::string text) {
     return list;
   };
   for (const auto& [placeholder, list] : {std::pair{std::string("{can-protocols}"), join(drivers::can_decoder_protocols(), false)},
-                                          std::pair{std::string("{hid-protocols}"), join(drivers::hid_decoder_protocols(), true)}})
+                                          std::pair{std::string("{hid-protocols}"), join(drivers::hid_decoder_protocols(), true)},
+                                          std::pair{std::string("{encodings}"), join(encoding_names(), true)}})
     for (std::size_t at = text.find(placeholder); at != std::string::npos; at = text.find(placeholder)) text.replace(at, placeholder.size(), list);
   return text;
 }
@@ -849,7 +856,8 @@ destinations = ["127.0.0.1:5702"]
 }
 
 TEST(Config, TheExampleConfigsLoad) {
-  for (const char* name : {"config/minimal.toml", "config/robot.toml", "config/vr-rig.toml", "data/demo/posefaird.toml"}) {
+  for (const char* name : {"config/minimal.toml", "config/robot.toml", "config/vr-rig.toml", "config/clients.toml",
+                           "data/demo/posefaird.toml"}) {
     SCOPED_TRACE(name);
     try {
       const DaemonConfig c = load_config(kSourceDir / name);
@@ -857,6 +865,38 @@ TEST(Config, TheExampleConfigsLoad) {
     } catch (const ConfigError& e) {
       ADD_FAILURE() << e.what();
     }
+  }
+}
+
+TEST(Config, TheRos2ExampleLoadsWhenTheBuildHasDds) {
+  // A build without Cyclone DDS has no dds encoding (docs/outputs.md): then the file is refused
+  // at its encoding key, like any unknown encoding.
+  try {
+    const DaemonConfig c = load_config(kSourceDir / "config/ros2.toml");
+    ASSERT_NE(find_output_encoder("dds"), nullptr);
+    ASSERT_EQ(c.outputs.size(), 1u);
+    EXPECT_EQ(c.outputs[0].encoder->name(), "dds");
+    EXPECT_TRUE(c.outputs[0].destinations.empty());
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(find_output_encoder("dds"), nullptr) << e.what();
+    EXPECT_EQ(e.key(), "output[1].encoding") << e.what();
+  }
+}
+
+TEST(Config, TheClientExampleSetsFramesRatesAndEncodings) {
+  const DaemonConfig c = load_config(kSourceDir / "config/clients.toml");
+  ASSERT_EQ(c.streams.size(), 3u);
+  EXPECT_TRUE(c.streams[0].frame.mounting.isApprox(Quat(0, 0, 0, 1), 1e-12) ||
+              c.streams[0].frame.mounting.isApprox(Quat(0, 0, 0, -1), 1e-12));  // 180° about z
+  EXPECT_TRUE(c.streams[1].frame.identity());
+  ASSERT_EQ(c.outputs.size(), 4u);
+  const char* names[] = {"opentrack", "freed", "vmc", "vrchat"};
+  const double rates[] = {250, 50, 60, 90};
+  const std::uint16_t ports[] = {4242, 40000, 39539, 9000};
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(c.outputs[i].encoder->name(), names[i]);
+    EXPECT_EQ(c.outputs[i].max_rate_hz, rates[i]);
+    EXPECT_EQ(c.outputs[i].destinations.at(0).port(), ports[i]) << names[i];
   }
 }
 
@@ -1086,7 +1126,88 @@ driver = { type = "synthetic" }
 [[output]]
 encoding = "jsn"
 destinations = ["127.0.0.1"]
-)", "output[1].encoding: expected one of 'binary', 'json', got 'jsn' (did you mean 'json'?)", 6},
+)", "output[1].encoding: expected one of {encodings}, got 'jsn' (did you mean 'json'?)", 6},
+    {"vrchat tracker out of range", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[output]]
+encoding = "vrchat"
+destinations = ["127.0.0.1"]
+trackers = [9]
+)", "output[1].trackers[1]: '9' is not a VRChat tracker: expected \"1\" to \"8\" or \"head\"", 8},
+    {"vmc bone that is not a Unity bone", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[stream]]
+id = 2
+name = "b"
+driver = { type = "synthetic" }
+[[output]]
+encoding = "vmc"
+destinations = ["127.0.0.1"]
+bones = ["Head",
+         "LeftPalm"]
+)", "output[1].bones[2]: 'LeftPalm' is not a Unity HumanBodyBones name", 13},
+    {"vmc bones fewer than the streams", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[stream]]
+id = 2
+name = "b"
+driver = { type = "synthetic" }
+[[output]]
+encoding = "vmc"
+destinations = ["127.0.0.1"]
+streams = [2, 1]
+bones = ["Head"]
+)", "output[1].bones: names 1 bones for the 2 streams the output carries", 13},
+    {"a vrchat key on an opentrack output", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[output]]
+encoding = "opentrack"
+destinations = ["127.0.0.1"]
+trackers = [1]
+)", "output[1].trackers: only for encoding 'vrchat'", 8},
+    {"freed zoom beyond 24 bits", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[output]]
+encoding = "freed"
+destinations = ["127.0.0.1"]
+zoom = 16777216
+)", "output[1].zoom: out of range: must be in [0, 16777215], got 16777216", 8},
+    {"max_rate_hz zero", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[[output]]
+destinations = ["127.0.0.1"]
+max_rate_hz = 0
+)", "output[1].max_rate_hz: out of range: must be > 0, got 0", 7},
+    {"mounting of two numbers", R"([[stream]]
+id = 1
+name = "a"
+mounting = [90, 0]
+driver = { type = "synthetic" }
+)", "stream[1].mounting: expected [yaw, pitch, roll] in degrees or a quaternion [w, x, y, z], got 2 numbers", 4},
+    {"world a quaternion of norm 2", R"([[stream]]
+id = 1
+name = "a"
+world = [2, 0, 0, 0]
+driver = { type = "synthetic" }
+)", "stream[1].world: a quaternion must have norm 1 (within 1e-3), got 2", 4},
+    {"mounting angle not a number", R"([[stream]]
+id = 1
+name = "a"
+mounting = [90, "left", 0]
+driver = { type = "synthetic" }
+)", "stream[1].mounting[2]: expected a number, got a string", 4},
     {"misspelt output key", R"([[stream]]
 id = 1
 name = "a"

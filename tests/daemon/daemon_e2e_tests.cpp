@@ -9,6 +9,8 @@
 //   DaemonRecording.*         SIGTERM while recording, the recording replayed; a truncated one
 //   DaemonConfigErrors.*      malformed configs exit 78 with FILE:LINE: and the key
 //   SubIdle.*                 `posefair sub --idle`
+//   DaemonClientEncodings.*   opentrack, freed, vmc and vrchat outputs beside a binary one, with
+//                             a stream's mounting and an output's max_rate_hz (dds: tests/dds)
 #include <signal.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -39,8 +41,10 @@
 #include "../protocol/subprocess.hpp"
 #include "../replay/replay_log.hpp"
 #include "../support/daemon_process.hpp"
+#include "../support/raw_udp_collector.hpp"
 #include "../support/pseudo_terminal.hpp"
 #include "../support/test_files.hpp"
+#include "posefair/daemon/client_frames.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
 #include "posefair/formats/pose_file.hpp"
@@ -554,6 +558,17 @@ std::vector<BadRow> bad_rows() {
        "ring_capacity = 1000", "stream[1].ring_capacity"},
       {"lag not below window", kPrelude + kStream1 + "[stream.engine]\nwindow = 8\nlag = 8\n", "lag = 8",
        "stream[1].engine.lag"},
+      {"unknown encoding", kPrelude + kStream1 + "\n[[output]]\nencoding = \"osc\"\ndestinations = [\"127.0.0.1:9\"]\n",
+       "encoding = \"osc\"", "output[1].encoding"},
+      {"vrchat tracker out of range",
+       kPrelude + kStream1 + "\n[[output]]\nencoding = \"vrchat\"\ndestinations = [\"127.0.0.1:9\"]\ntrackers = [9]\n",
+       "trackers = [9]", "output[1].trackers[1]"},
+      {"not a Unity bone",
+       kPrelude + kStream1 + "\n[[output]]\nencoding = \"vmc\"\ndestinations = [\"127.0.0.1:9\"]\nbones = [\"Pelvis\"]\n",
+       "bones = [\"Pelvis\"]", "output[1].bones[1]"},
+      {"mounting not a rotation", kPrelude + "[[stream]]\nid = 1\nname = \"a\"\nmounting = [0, 90]\n"
+                                             "driver = { type = \"synthetic\", duration = 0.1 }\n",
+       "mounting = [0, 90]", "stream[1].mounting"},
   };
 }
 
@@ -593,7 +608,96 @@ TEST(DaemonConfigErrors, AGoodConfigPassesTheCheck) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// 7. posefair sub --idle
+// 7. The client encodings (docs/outputs.md) from a running daemon
+
+double le_double(const std::vector<std::uint8_t>& d, std::size_t at) {
+  std::uint64_t bits = 0;
+  for (int b = 7; b >= 0; --b) bits = (bits << 8) | d[at + static_cast<std::size_t>(b)];
+  double v = 0;
+  std::memcpy(&v, &bits, 8);
+  return v;
+}
+
+bool contains(const std::vector<std::uint8_t>& d, std::string_view text) {
+  return std::search(d.begin(), d.end(), text.begin(), text.end()) != d.end();
+}
+
+TEST(DaemonClientEncodings, EveryEncodingCarriesItsStreamWithTheStreamsMounting) {
+  ScratchDir dir("posefair-e2e-");
+  Collector binary;
+  RawUdpCollector opentrack, freed, vmc, vrchat;
+  auto to = [](std::uint16_t port) { return "destinations = [\"127.0.0.1:" + std::to_string(port) + "\"]\n"; };
+  const fs::path config = dir / "clients.toml";
+  write_text(config, "[daemon]\nexit_when_sources_end = true\n[logging]\nstatus_interval = 0\n\n"
+                     "[[stream]]\nid = 1\nname = \"head\"\nmounting = [-90, 0, 0]\n"
+                     "driver = { type = \"synthetic\", rate_hz = 200.0, duration = 1.0, with_position = true }\n"
+                     "[[stream]]\nid = 2\nname = \"hips\"\n"
+                     "driver = { type = \"synthetic\", rate_hz = 200.0, duration = 1.0, seed = 2 }\n\n"
+                     "[[output]]\n" + to(binary.port()) +
+                     "[[output]]\nencoding = \"opentrack\"\nstreams = [1]\n" + to(opentrack.port()) +
+                     "[[output]]\nencoding = \"freed\"\nstreams = [2]\nmax_rate_hz = 20\nzoom = 77\n" + to(freed.port()) +
+                     "[[output]]\nencoding = \"vmc\"\nbones = [\"Head\", \"Hips\"]\n" + to(vmc.port()) +
+                     "[[output]]\nencoding = \"vrchat\"\ntrackers = [\"head\", 1]\n" + to(vrchat.port()));
+  Subprocess d(daemon_args(config), dir / "out", dir / "err");
+  ASSERT_EQ(d.wait(30s), 0) << d.err();
+  binary.drain();
+  ASSERT_TRUE(wait_until([&] { return opentrack.datagrams().size() >= binary.count(1); }, 5s));
+
+  // opentrack: stream 1 only, every pose, each the binary pose's angles (the mounting applied
+  // once, before both encodings).
+  std::vector<daemon::PoseMessage> head;
+  for (const daemon::PoseMessage& m : binary.messages())
+    if (m.stream == 1) head.push_back(m);
+  const auto ot = opentrack.datagrams();
+  ASSERT_GT(head.size(), 100u);
+  ASSERT_EQ(ot.size(), head.size());
+  for (std::size_t i = 0; i < ot.size(); i += 37) {
+    ASSERT_EQ(ot[i].size(), 48u);
+    const daemon::HeadAngles a = daemon::head_angles(head[i].orientation);
+    EXPECT_NEAR(le_double(ot[i], 24), a.yaw, 1e-9) << "pose " << i;
+    EXPECT_NEAR(le_double(ot[i], 32), a.pitch, 1e-9) << "pose " << i;
+    EXPECT_NEAR(le_double(ot[i], 0), -100.0 * head[i].position->y(), 1e-9) << "pose " << i;
+  }
+
+  // freed: stream 2 at most 20 a second over 1 s, each a valid D1 message with zoom 77.
+  const auto fd = freed.datagrams();
+  EXPECT_GE(fd.size(), 15u);
+  EXPECT_LE(fd.size(), 21u);
+  for (const auto& m : fd) {
+    ASSERT_EQ(m.size(), 29u);
+    EXPECT_EQ(m[0], 0xD1);
+    EXPECT_EQ(m[1], 2);  // the stream's id is its camera id
+    unsigned sum = 0;
+    for (std::uint8_t b : m) sum += b;
+    EXPECT_EQ(sum % 256, 0x40u);
+    EXPECT_EQ(m[22], 77);
+  }
+
+  // vmc and vrchat: one OSC bundle per pose of either stream, to its bone or tracker.
+  const std::size_t poses = binary.count(1) + binary.count(2);
+  const auto vm = vmc.datagrams();
+  const auto vr = vrchat.datagrams();
+  EXPECT_EQ(vm.size(), poses);
+  EXPECT_EQ(vr.size(), poses);
+  std::size_t heads = 0, hips = 0, head_tracker = 0, tracker1 = 0;
+  for (const auto& b : vm) {
+    EXPECT_TRUE(contains(b, "#bundle"));
+    EXPECT_TRUE(contains(b, "/VMC/Ext/Bone/Pos"));
+    heads += contains(b, "Head");
+    hips += contains(b, "Hips");
+  }
+  for (const auto& b : vr) {
+    head_tracker += contains(b, "/tracking/trackers/head/rotation");
+    tracker1 += contains(b, "/tracking/trackers/1/rotation") && !contains(b, "/tracking/trackers/1/position");
+  }
+  EXPECT_EQ(heads, binary.count(1));
+  EXPECT_EQ(hips, binary.count(2));
+  EXPECT_EQ(head_tracker, binary.count(1));
+  EXPECT_EQ(tracker1, binary.count(2));  // stream 2 has no position: rotation only
+}
+
+// ---------------------------------------------------------------------------------------------
+// 8. posefair sub --idle
 
 TEST(SubIdle, ExitsAboutIdleSecondsAfterTheLastDatagram) {
   ScratchDir dir("posefair-e2e-");

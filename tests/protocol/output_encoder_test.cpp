@@ -22,15 +22,19 @@ TEST(OutputEncoderRegistry, EveryEntryBuildsAnEncoderOfItsName) {
       EXPECT_FALSE(o.name.empty());
       EXPECT_FALSE(o.doc.empty());
     }
-    const auto encoder = e->make({});
+    const auto encoder = e->make({}, {});
     ASSERT_NE(encoder, nullptr);
     EXPECT_EQ(encoder->name(), e->name);
   }
   EXPECT_EQ(find_output_encoder("no-such-encoding"), nullptr);
 }
 
-TEST(OutputEncoderRegistry, BinaryIsTheDefaultAndJsonIsRegistered) {
-  EXPECT_EQ(output_encoder_names(), (std::vector<std::string_view>{"binary", "json"}));
+TEST(OutputEncoderRegistry, BinaryIsTheDefaultAndTheClientEncodingsAreRegistered) {
+  std::vector<std::string_view> expected{"binary", "json", "opentrack", "freed", "vmc", "vrchat"};
+#ifdef POSEFAIR_WITH_DDS  // the build found Cyclone DDS (daemon/CMakeLists.txt)
+  expected.push_back("dds");
+#endif
+  EXPECT_EQ(output_encoder_names(), expected);
   EXPECT_EQ(default_output_encoder()->name(), "binary");
 }
 
@@ -40,7 +44,7 @@ TEST(OutputEncoderRegistry, AnEncodingWithoutOptionsRefusesAnyNamingTheKey) {
     SCOPED_TRACE(std::string(e->name));
     const posefair::OptionMap given{{"zoom", std::int64_t{2}}};
     try {
-      (void)e->make(given);
+      (void)e->make(given, {});
       ADD_FAILURE() << "an undeclared option was accepted";
     } catch (const posefair::OptionError& error) {
       EXPECT_EQ(error.key(), "zoom");
@@ -52,7 +56,7 @@ TEST(OutputEncoderRegistry, AnEncodingWithoutOptionsSharesOneEncoder) {
   for (const OutputEncoderEntry* e : output_encoder_entries()) {
     if (!e->options.empty()) continue;
     SCOPED_TRACE(std::string(e->name));
-    EXPECT_EQ(e->make({}), e->make({}));
+    EXPECT_EQ(e->make({}, {}), e->make({}, {}));
   }
 }
 

@@ -25,6 +25,7 @@ enum class OptionType {
   Boolean,
   IntegerOrString,  // a number written either way (0x4F, "0x4F", 16): the decoder reads the text
   IntegerArray,
+  StringArray,      // one value per item, e.g. a name per stream an output carries
 };
 // "a string", "an integer", ... (for messages and the docs).
 std::string_view to_string(OptionType type);
@@ -39,7 +40,7 @@ struct OptionSpec {
 
 // A value as the configuration gave it: IntegerOrString values arrive as their text (an integer
 // as its decimal digits), Float values as double even when written as an integer.
-using OptionValue = std::variant<std::string, std::int64_t, double, bool, std::vector<std::int64_t>>;
+using OptionValue = std::variant<std::string, std::int64_t, double, bool, std::vector<std::int64_t>, std::vector<std::string>>;
 using OptionMap = std::map<std::string, OptionValue, std::less<>>;
 
 // A value a decoder refuses. key() is the option's name, with "[n]" (1-based) for an element of
@@ -78,6 +79,7 @@ class OptionReader {
   double real(std::string_view key) const;  // Float keys
   bool boolean(std::string_view key) const;
   std::vector<std::int64_t> integers(std::string_view key) const;  // IntegerArray keys, given only
+  std::vector<std::string> strings(std::string_view key) const;     // StringArray keys, given only
 
  private:
   const OptionSpec& spec(std::string_view key) const;

@@ -18,6 +18,7 @@
 #include "posefair/core/fairing_window.hpp"
 #include "posefair/core/pose_spline.hpp"
 #include "posefair/core/rigid_pose_lerp.hpp"
+#include "posefair/daemon/client_frames.hpp"
 #include "posefair/daemon/output_encoder.hpp"
 #include "posefair/daemon/overflow_policy.hpp"
 #include "posefair/daemon/udp_socket.hpp"
@@ -194,6 +195,9 @@ struct StreamConfig {
   SplineConfig spline;
   std::optional<GpioConfig> gpio;
   std::optional<FusionConfig> fusion;
+  // `mounting` and `world`: corrections applied to every published pose of the stream, before
+  // any encoding (client_frames.hpp, docs/outputs.md).
+  StreamFrame frame;
 };
 
 struct OutputConfig {
@@ -203,6 +207,7 @@ struct OutputConfig {
   SendOptions send;                                // ttl (default 1), interface, loopback
   std::vector<std::uint32_t> streams;              // the streams this output carries; empty = all
   bool angular_velocity = false;  // include the body rate between consecutive emitted poses
+  double max_rate_hz = 0.0;       // > 0: at most this many poses a second per stream; 0 = every pose
 };
 
 struct RecorderConfig {

@@ -13,8 +13,10 @@
 #include <string>
 #include <vector>
 
+#include "posefair/daemon/client_frames.hpp"
 #include "posefair/daemon/config.hpp"
 #include "posefair/daemon/output_encoder.hpp"
+#include "posefair/daemon/output_rate_limit.hpp"
 #include "posefair/daemon/ring_items.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
@@ -24,10 +26,11 @@ namespace posefair::daemon {
 class Publisher {
  public:
   // `stream_ids[i]` is the wire id of stream index i. `first_sequence` gives, per wire stream
-  // id, the sequence number to continue from (missing: 0). Opens the sockets now; throws
-  // std::system_error when one cannot be opened.
+  // id, the sequence number to continue from (missing: 0). `frames[i]` is stream i's mounting and
+  // world correction (missing: none), applied before any encoding. Opens the sockets now;
+  // throws std::system_error when one cannot be opened.
   Publisher(std::uint32_t session, std::vector<std::uint32_t> stream_ids, const std::vector<OutputConfig>& outputs,
-            const std::map<std::uint32_t, std::uint64_t>& first_sequence);
+            const std::map<std::uint32_t, std::uint64_t>& first_sequence, const std::vector<StreamFrame>& frames = {});
 
   struct Result {
     bool carried = false;           // at least one output carries this stream
@@ -48,6 +51,7 @@ class Publisher {
     bool angular_velocity;
     std::vector<char> carries;  // per stream index
     UdpSender sender;
+    OutputRateLimit rate_limit;  // max_rate_hz
   };
   // One per distinct encoder among the outputs: its datagram for the pose being published.
   struct Encoded {
@@ -58,6 +62,7 @@ class Publisher {
   };
   struct StreamState {
     std::uint32_t id = 0;
+    StreamFrame frame;
     std::uint64_t next_sequence = 0;
     bool have_previous = false;
     double previous_time = 0.0;
