@@ -22,6 +22,8 @@ packages=(
   libserialport-dev      # the serial driver: ports by path or USB id, settings (drivers)
   libnlopt-cxx-dev       # the quaternion spline optimiser (core)
   libgpiod-dev           # GPIO data-ready and scope lines, libgpiod 1.6 (drivers)
+  libsodium-dev          # subscription cookies and pre-shared-key MACs (daemon)
+  iproute2 util-linux    # the attack tests' network namespaces (ip, unshare, setpriv)
 )
 # The hw tests' VM (tests/hw/vm/): Debian's own kernel under qemu, gpio-sim built against its
 # headers, and the tests' independent peers. Only amd64 boots that kernel.
