@@ -92,7 +92,10 @@ void print_subscribers(const nlohmann::json& subscribers) {
   std::printf("%-40s %-8s %-12s %9s %10s\n", "subscriber", "encoding", "streams", "lease s", "sent");
   for (const auto& s : subscribers) {
     std::string streams;
-    for (const auto& id : s["streams"]) streams += (streams.empty() ? "" : ",") + num(id);
+    for (const auto& id : s["streams"]) {
+      if (!streams.empty()) streams += ',';
+      streams += num(id);
+    }
     std::printf("%-40s %-8s %-12s %9s %10s\n", s["address"].get<std::string>().c_str(), s["encoding"].get<std::string>().c_str(),
                 streams.empty() ? "all" : streams.c_str(), num(s["lease_left_s"]).c_str(), num(s["sent"]).c_str());
   }
@@ -129,8 +132,11 @@ void print_human(const nlohmann::json& reply) {
 
 int run_ctl(const CtlOptions& o) {
   std::string line;
-  for (const std::string& w : o.words) line += (line.empty() ? "" : " ") + w;
-  line += "\n";
+  for (const std::string& w : o.words) {
+    if (!line.empty()) line += ' ';
+    line += w;
+  }
+  line += '\n';
   const auto command = daemon::parse_control_command(std::span(reinterpret_cast<const std::uint8_t*>(line.data()), line.size()));
   if (!command) {
     std::cerr << "posefair ctl: not a command: " << line.substr(0, line.size() - 1)

@@ -20,6 +20,7 @@
 
 #include "posefair/core/error.hpp"
 #include "posefair/daemon/json_lines.hpp"
+#include "posefair/daemon/output_encoder.hpp"
 #include "posefair/daemon/subscription_client.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 

@@ -246,7 +246,15 @@ class Service {
   std::string control(const ControlCommand& c, const PeerCredentials& peer) {
     const std::string who = fmt::format("pid {} uid {} gid {}", peer.pid, peer.uid, peer.gid);
     if (changes_daemon(c.verb)) spdlog::info("control socket: '{}' from {}", to_string(c.verb), who);
-    const auto ok = [](const std::string& members) { return "{\"ok\":true" + (members.empty() ? "" : "," + members) + "}"; };
+    const auto ok = [](const std::string& members) {
+      std::string reply = "{\"ok\":true";
+      if (!members.empty()) {
+        reply += ',';
+        reply += members;
+      }
+      reply += '}';
+      return reply;
+    };
     const auto now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
     switch (c.verb) {
       case ControlVerb::Status: {

@@ -8,12 +8,20 @@
 namespace posefair::daemon {
 namespace {
 std::chrono::nanoseconds steady_now() { return std::chrono::steady_clock::now().time_since_epoch(); }
+
+// A deeper queue than the default, so a burst waits for the thread instead of being dropped
+// (the kernel caps it at net.core.rmem_max).
+ReceiveOptions receive_options() {
+  ReceiveOptions o;
+  o.receive_buffer_bytes = 1 << 20;
+  return o;
+}
 }  // namespace
 
 SubscriptionServer::SubscriptionServer(SubscriptionSettings settings)
     : table_(std::make_shared<SubscriberTable>(settings.max_subscribers, settings.max_per_address)),
       handler_(settings, table_),
-      socket_(UdpSocket::bind(settings.listen)) {}
+      socket_(UdpSocket::bind(settings.listen, receive_options())) {}
 
 SubscriptionServer::~SubscriptionServer() { stop(); }
 
