@@ -9,7 +9,7 @@ docs/protocol.md, which is the specification.
 
     python3 tools/posefair_sub.py --listen 0.0.0.0:5700 --format csv --count 1000
     python3 tools/posefair_sub.py --group 239.255.80.70 --interface eth0
-    python3 tools/posefair_sub.py --subscribe 127.0.0.1:5701 --streams 1,2 --encoding json
+    python3 tools/posefair_sub.py --subscribe 127.0.0.1:5710 --streams 1,2 --encoding json
 
 The decoding functions (decode_binary, decode_json, decode) can be imported:
     from posefair_sub import decode, DecodeError
@@ -405,7 +405,7 @@ def format_csv(pose, received_at):
 
 # --- Subscribing (docs/protocol.md, "Subscribing") ----------------------------------------------
 SUB_MAGIC = b"PFS1"
-DEFAULT_CONTROL_PORT = 5701
+DEFAULT_CONTROL_PORT = 5710
 SUBSCRIBE, UNSUBSCRIBE = 1, 2
 COOKIE, SUBSCRIBED, UNSUBSCRIBED, REFUSED = 0x81, 0x82, 0x83, 0x84
 REQ_ANGULAR_VELOCITY, REQ_AUTHENTICATED = 1, 2

@@ -459,7 +459,7 @@ void add_sub_command(CLI::App& app, int& exit_code) {
   cmd->add_flag("--quiet", o->quiet, "print no poses, only the statistics");
   cmd->add_flag("--stats", o->stats, "also print one statistics line per (session, stream) at exit");
   auto* subscribe = cmd->add_option("--subscribe", o->subscribe,
-                                    "sign up on a daemon's subscription port HOST:PORT (default port 5701) and keep the lease");
+                                    "sign up on a daemon's subscription port HOST:PORT (default port 5710) and keep the lease");
   cmd->add_option("--streams", o->streams, "with --subscribe: the stream ids wanted (default: every stream)")
       ->delimiter(',')
       ->needs(subscribe);

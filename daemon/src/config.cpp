@@ -1340,7 +1340,7 @@ class Parser {
       const std::string text = get_string(*n, key("listen"));
       const auto e = Endpoint::parse(text, kDefaultControlPort);
       if (!e || e->is_multicast())
-        fail(*n, key("listen"), "not a local address: " + in_quotes(text) + "; expected e.g. '127.0.0.1:5701' or '[::1]:5701'");
+        fail(*n, key("listen"), "not a local address: " + in_quotes(text) + "; expected e.g. '127.0.0.1:5710' or '[::1]:5710'");
       s.listen = *e;
     }
     if (const toml::node* n = t.get("allow")) {

@@ -169,7 +169,10 @@ class Service {
         spdlog::info("{}: draining and stopping", sig == SIGTERM ? "SIGTERM" : "SIGINT");
         return finish("stopped");
       }
-      if (sig == SIGHUP) reload();
+      if (sig == SIGHUP) {
+        spdlog::info("SIGHUP");
+        reload();
+      }
       if (sig == SIGUSR1) log_counters(*pipeline_, last_log_stats_, seconds_since(last_log_));
 
       // The engine thread is alive when it went round its loop since the last poke.

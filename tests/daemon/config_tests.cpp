@@ -882,7 +882,7 @@ group = "root"
                                       dir.path() / "cfg.toml");
   ASSERT_TRUE(c.subscription);
   const SubscriptionSettings& s = *c.subscription;
-  EXPECT_EQ(s.listen.to_string(), "[::1]:5701");
+  EXPECT_EQ(s.listen.to_string(), "[::1]:5710");
   ASSERT_EQ(s.allow.ranges().size(), 3u);
   EXPECT_EQ(s.allow.ranges()[2].to_string(), "10.1.2.3/32");
   EXPECT_EQ(s.max_subscribers, 8u);
@@ -901,7 +901,7 @@ group = "root"
   const DaemonConfig d = parse_config("[[stream]]\nid = 1\nname = \"a\"\ndriver = { type = \"synthetic\" }\n"
                                       "[subscription]\n[control]\n",
                                       dir.path() / "cfg.toml");
-  EXPECT_EQ(d.subscription->listen.to_string(), "127.0.0.1:5701");
+  EXPECT_EQ(d.subscription->listen.to_string(), "127.0.0.1:5710");
   EXPECT_TRUE(d.subscription->allow.allows(*Endpoint::parse("127.0.0.1:1")));
   EXPECT_FALSE(d.subscription->allow.allows(*Endpoint::parse("192.168.1.1:1")));
   EXPECT_EQ(d.control->path, "/run/posefaird/control");
@@ -1219,8 +1219,8 @@ id = 1
 name = "a"
 driver = { type = "synthetic" }
 [subscription]
-listen = "localhost:5701"
-)", "subscription.listen: not a local address: 'localhost:5701'", 6},
+listen = "localhost:5710"
+)", "subscription.listen: not a local address: 'localhost:5710'", 6},
     {"subscription: allow not a CIDR range", R"([[stream]]
 id = 1
 name = "a"

@@ -1,7 +1,7 @@
 // Attacks on the subscription port and the control socket (docs/security.md, "How each claim
 // is tested"), against the real posefaird. Each test runs in a network namespace of its own
 // (unshare(CLONE_NEWNET) on the test's thread, loopback brought up, nothing else), so the fixed
-// port 5701 is free and no datagram leaves the namespace; source addresses are forged with a
+// port 5710 is free and no datagram leaves the namespace; source addresses are forged with a
 // raw socket. Needs root, as the rest of the suite does (tools/test.sh).
 //
 //   SubscriptionAttack.SpoofedSubscribe*   a victim named by forged requests gets at most its
@@ -142,7 +142,7 @@ class Victim {
   std::thread thread_;
 };
 
-// posefaird with a synthetic 200 Hz stream, the subscription port on 127.0.0.1:5701 and the
+// posefaird with a synthetic 200 Hz stream, the subscription port on 127.0.0.1:5710 and the
 // control socket in a temporary folder; `extra` goes into [subscription].
 class Daemon {
  public:
@@ -153,7 +153,7 @@ class Daemon {
     const fs::path config = dir_.path() / "posefaird.toml";
     std::ofstream(config) << "[[stream]]\nid = 1\nname = \"head\"\n[stream.driver]\ntype = \"synthetic\"\nrate_hz = 200\n"
                           << "[[stream]]\nid = 2\nname = \"hand\"\n[stream.driver]\ntype = \"synthetic\"\nrate_hz = 100\n"
-                          << "[subscription]\nlisten = \"127.0.0.1:5701\"\n" << extra << "\n"
+                          << "[subscription]\nlisten = \"127.0.0.1:5710\"\n" << extra << "\n"
                           << "[control]\nsocket = \"" << socket_.string() << "\"\nmode = 0o660\n";
     process_ = std::make_unique<Subprocess>(daemon_args(config), dir_.path() / "out", dir_.path() / "err");
     if (!wait_for_log_or_exit(*process_, "started:", 10s)) throw std::runtime_error("posefaird did not start: " + process_->err());
@@ -165,7 +165,7 @@ class Daemon {
   Subprocess& process() { return *process_; }
   const fs::path& socket() const { return socket_; }
   const fs::path& dir() const { return dir_.path(); }
-  Endpoint port() const { return *Endpoint::parse("127.0.0.1:5701"); }
+  Endpoint port() const { return *Endpoint::parse("127.0.0.1:5710"); }
 
   // `posefair ctl ARGS --json`, optionally run through a prefix (setpriv ...); the exit status and stdout.
   std::pair<int, std::string> ctl(const std::vector<std::string>& args, std::vector<std::string> prefix = {}) {
@@ -215,7 +215,7 @@ std::uint64_t resident_kib(long pid) {
 // A `posefair sub --subscribe` that must receive `count` poses.
 std::unique_ptr<Subprocess> subscriber(const fs::path& dir, const std::string& name, int count,
                                        std::vector<std::string> extra = {}) {
-  std::vector<std::string> argv = {kPosefair, "sub", "--subscribe", "127.0.0.1:5701", "--quiet", "--count", std::to_string(count),
+  std::vector<std::string> argv = {kPosefair, "sub", "--subscribe", "127.0.0.1:5710", "--quiet", "--count", std::to_string(count),
                                    "--duration", "20"};
   argv.insert(argv.end(), extra.begin(), extra.end());
   return std::make_unique<Subprocess>(argv, dir / (name + ".out"), dir / (name + ".err"));
@@ -407,7 +407,7 @@ TEST(SubscriptionClients, PosefairSubAndThePythonClientSubscribeRenewAndLeave) {
   Daemon d;
   // A lease of one second: the 2.5 s of poses asked for need two renewals.
   auto cpp = subscriber(d.dir(), "cpp", 500, {"--lease", "1", "--streams", "1", "--encoding", "json"});
-  Subprocess py({kPython, kPythonClient, "--subscribe", "127.0.0.1:5701", "--quiet", "--count", "250", "--duration", "20",
+  Subprocess py({kPython, kPythonClient, "--subscribe", "127.0.0.1:5710", "--quiet", "--count", "250", "--duration", "20",
                  "--lease", "1", "--streams", "2"},
                 d.dir() / "py.out", d.dir() / "py.err");
   ASSERT_EQ(cpp->wait(20s), 0) << cpp->err();

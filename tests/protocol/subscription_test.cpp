@@ -426,7 +426,7 @@ TEST_F(HandlerFixture, AmplificationBeforeVerificationIsAtMostOne) {
 }
 
 TEST(SubscriptionClientMachine, HandshakeRenewalAndRefusal) {
-  const Endpoint server = ep("127.0.0.1:5701");
+  const Endpoint server = ep("127.0.0.1:5710");
   SubscriptionClient client(server, example_subscribe(), std::nullopt, 10);
   auto t = SubscriptionClient::Clock::time_point{} + 1000s;
   const auto first = client.due(t);

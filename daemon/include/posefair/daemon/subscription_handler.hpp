@@ -32,7 +32,7 @@ namespace posefair::daemon {
 
 // [subscription] (docs/config.md).
 struct SubscriptionSettings {
-  Endpoint listen = *Endpoint::parse("127.0.0.1:5701");
+  Endpoint listen = *Endpoint::parse("127.0.0.1:5710");
   AddressAllowList allow = AddressAllowList::loopback();
   std::uint32_t max_subscribers = 16;
   std::uint32_t max_per_address = 4;

@@ -20,7 +20,7 @@
 namespace posefair::daemon {
 
 inline constexpr std::array<std::uint8_t, 4> kSubscriptionMagic = {0x50, 0x46, 0x53, 0x31};  // "PFS1"
-inline constexpr std::uint16_t kDefaultControlPort = 5701;
+inline constexpr std::uint16_t kDefaultControlPort = 5710;
 inline constexpr std::size_t kCookieSize = 16;
 inline constexpr std::size_t kRequestHeaderSize = 32;
 inline constexpr std::size_t kReplySize = 32;
