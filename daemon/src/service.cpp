@@ -267,7 +267,8 @@ class Service {
                                     ::getpid(), json_string(options_.config.string()), session_, json_number(seconds_since(started_)),
                                     config.streams.size(), config.outputs.size(),
                                     config.recorder.enabled ? (pipeline_->recording() ? "true" : "false") : "null");
-        m += ",\"subscribers\":" + (subscription_ ? std::to_string(subscription_->table()->size()) : std::string("null"));
+        m += ",\"subscribers\":";
+        m += subscription_ ? std::to_string(subscription_->table()->size()) : std::string("null");
         return ok(m);
       }
       case ControlVerb::Streams:
@@ -277,9 +278,12 @@ class Service {
         return ok(subscribers_member(subscription_->table()->list(), now_ns));
       case ControlVerb::Counters: {
         std::string m = streams_member(pipeline_->stats(), last_status_stats_, seconds_since(last_status_));
-        if (subscription_)
-          m += "," + subscription_member(subscription_->handler(), subscription_->table()->size()) + "," +
-               subscribers_member(subscription_->table()->list(), now_ns);
+        if (subscription_) {
+          m += ',';
+          m += subscription_member(subscription_->handler(), subscription_->table()->size());
+          m += ',';
+          m += subscribers_member(subscription_->table()->list(), now_ns);
+        }
         return ok(m);
       }
       case ControlVerb::Reload: {
