@@ -23,7 +23,8 @@ packages=(
   libnlopt-cxx-dev       # the quaternion spline optimiser (core)
   libgpiod-dev           # GPIO data-ready and scope lines, libgpiod 1.6 (drivers)
   libsodium-dev          # subscription cookies and pre-shared-key MACs (daemon)
-  iproute2 util-linux    # the attack tests' network namespaces (ip, unshare, setpriv)
+  nlohmann-json3-dev     # posefair ctl reads the daemon's JSON replies (tools, tests)
+  iproute2 util-linux    # the attack tests' network namespaces and other users (ip, setpriv)
 )
 # The hw tests' VM (tests/hw/vm/): Debian's own kernel under qemu, gpio-sim built against its
 # headers, and the tests' independent peers. Only amd64 boots that kernel.
