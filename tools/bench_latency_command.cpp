@@ -19,6 +19,8 @@
 #include "posefair/core/error.hpp"
 #include "posefair/daemon/config.hpp"
 #include "posefair/daemon/pipeline.hpp"
+#include "posefair/daemon/subscription_client.hpp"
+#include "posefair/daemon/subscription_server.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
 
@@ -42,6 +44,86 @@ struct LatencyOptions {
   // docs/outputs.md) to a socket nobody reads, to see what enabling them all costs.
   bool all_encodings = false;
   double client_rate = 0.0;  // > 0: max_rate_hz of those outputs
+  // --control-flood RATE: a subscription port in process, flooded with RATE unverified SUBSCRIBE
+  // datagrams a second (every one processed: no rate limit), while one client subscribes.
+  double control_flood = -1.0;  // < 0: no subscription port
+};
+
+// The subscription port's side of the bench: the server, the flood and one real subscriber.
+struct ControlFlood {
+  std::unique_ptr<daemon::SubscriptionServer> server;
+  std::thread flood, client;
+  std::atomic<bool> stop{false};
+  std::atomic<std::uint64_t> sent{0};
+  std::atomic<double> first_pose_ms{-1.0};
+  double seconds = 0.0, server_cpu = 0.0;
+
+  explicit ControlFlood(double rate, double duration, const std::vector<std::uint32_t>& streams) {
+    daemon::SubscriptionSettings s;
+    s.listen = *daemon::Endpoint::parse("127.0.0.1:0");
+    s.rate_per_source = 1e9;
+    s.burst_per_source = 1e9;
+    server = std::make_unique<daemon::SubscriptionServer>(s);
+    server->handler().set_streams(streams);
+    server->start();
+    const daemon::Endpoint port = server->local_endpoint();
+    if (rate > 0)
+      flood = std::thread([this, rate, port] {
+        daemon::UdpSocket socket = daemon::UdpSocket::bind(*daemon::Endpoint::parse("127.0.0.1:0"));
+        daemon::SubscriptionRequest r;
+        r.encoding = "binary";
+        r.lease_ms = 30000;
+        const auto t0 = std::chrono::steady_clock::now();
+        for (std::uint64_t i = 0; !stop.load(std::memory_order_relaxed); ++i) {
+          r.request_id = static_cast<std::uint32_t>(i);
+          socket.send_to(daemon::encode_request(r), port);
+          sent.fetch_add(1, std::memory_order_relaxed);
+          if (i % 100 == 99) std::this_thread::sleep_until(t0 + std::chrono::duration<double>(static_cast<double>(i + 1) / rate));
+        }
+        seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      });
+    // One subscriber, a second in: from its first SUBSCRIBE to its first pose.
+    client = std::thread([this, port, duration] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(std::min(1000, static_cast<int>(duration * 250))));
+      daemon::UdpSocket socket = daemon::UdpSocket::bind(*daemon::Endpoint::parse("127.0.0.1:0"));
+      daemon::SubscriptionRequest r;
+      r.encoding = "binary";
+      r.lease_ms = 30000;
+      daemon::SubscriptionClient c(port, r, std::nullopt, 1);
+      std::vector<std::uint8_t> buf(daemon::kMaxDatagramSize + 1);
+      const auto t0 = std::chrono::steady_clock::now();
+      while (!stop.load(std::memory_order_relaxed)) {
+        if (auto request = c.due(std::chrono::steady_clock::now())) socket.send_to(*request, port);
+        const auto d = socket.receive(buf, std::chrono::milliseconds(5));
+        if (!d) continue;
+        const std::span<const std::uint8_t> bytes(buf.data(), d->size);
+        if (c.on_reply(bytes, d->source, std::chrono::steady_clock::now())) continue;
+        if (daemon::decode_datagram(bytes)) {
+          first_pose_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+          return;
+        }
+      }
+    });
+  }
+  void finish() {
+    stop = true;
+    if (flood.joinable()) flood.join();
+    if (client.joinable()) client.join();
+    server->stop();
+  }
+  void print() const {
+    const daemon::SubscriptionCounters& c = server->handler().counters();
+    const auto get = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
+    const double in = static_cast<double>(get(c.unverified_bytes_in)), out = static_cast<double>(get(c.unverified_bytes_out));
+    std::printf("control     flood %" PRIu64 " datagrams in %.2f s (%.0f/s); port processed %" PRIu64 " (%.0f/s), %" PRIu64
+                " cookies; amplification %.3f\n",
+                sent.load(), seconds, seconds > 0 ? static_cast<double>(sent.load()) / seconds : 0.0, get(c.datagrams),
+                seconds > 0 ? static_cast<double>(get(c.datagrams)) / seconds : 0.0, get(c.cookies_sent), in > 0 ? out / in : 0.0);
+    if (first_pose_ms.load() >= 0)
+      std::printf("subscribe   first pose %.2f ms after the first SUBSCRIBE\n", first_pose_ms.load());
+    else
+      std::printf("subscribe   no pose reached the subscriber\n");
+  }
 };
 
 // The extra [[output]] tables of --all-encodings: every registered encoding but the first (the
@@ -148,12 +230,19 @@ int bench_latency(const LatencyOptions& o) {
   std::printf("bench latency: %d streams at %.0f Hz for %.1f s, window %d, lag %d, %s solver, ring %d, realtime priority %d, %s%s\n",
               o.streams, o.rate, o.duration, o.window, o.lag, o.solver.c_str(), o.ring_capacity, o.realtime_priority,
               o.aligned ? "phases aligned" : "phases spread", o.all_encodings ? ", every encoding" : "");
+  std::unique_ptr<ControlFlood> control;
+  if (o.control_flood >= 0) {
+    std::vector<std::uint32_t> ids;
+    for (const auto& s : config.streams) ids.push_back(s.id);
+    control = std::make_unique<ControlFlood>(o.control_flood, o.duration, ids);
+  }
   const double cpu0 = process_cpu_seconds();
   const auto t0 = std::chrono::steady_clock::now();
   {
-    daemon::Pipeline pipeline(config, 0x62656e63, {});
+    daemon::Pipeline pipeline(config, 0x62656e63, {}, false, {}, control ? control->server->table() : nullptr);
     for (const std::string& w : pipeline.start()) std::fprintf(stderr, "warning: %s\n", w.c_str());
     while (!pipeline.sources_ended()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (control) control->finish();
     pipeline.stop();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the last datagrams
@@ -192,8 +281,9 @@ int bench_latency(const LatencyOptions& o) {
       std::printf("receiver    none (datagrams sent to a socket nobody reads)\n");
     else
       std::printf("receiver    %" PRIu64 " datagrams, %" PRIu64 " lost (sequence gaps)\n", datagrams.load(), lost.load());
-    std::printf("cpu         %.3f s in %.2f s wall: %.1f%% of one core, %.2f%% per stream at %.0f Hz (receiver excluded)\n",
-                cpu, wall, 100.0 * cpu / wall, 100.0 * cpu / wall / o.streams, o.rate);
+    std::printf("cpu         %.3f s in %.2f s wall: %.1f%% of one core, %.2f%% per stream at %.0f Hz (receiver excluded%s)\n",
+                cpu, wall, 100.0 * cpu / wall, 100.0 * cpu / wall / o.streams, o.rate, control ? ", flood included" : "");
+    if (control) control->print();
   }
   return kExitOk;
 }
@@ -222,6 +312,10 @@ void add_bench_latency_command(CLI::App& bench, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 100000.0));
   cmd->add_flag("--aligned", o->aligned, "all streams sample at the same instant (default: phases spread over the period)");
+  cmd->add_option("--control-flood", o->control_flood,
+                  "also run a subscription port, flooded with this many unverified SUBSCRIBEs a second (0: none), while "
+                  "one client subscribes")
+      ->check(CLI::Range(0.0, 1e7));
   cmd->add_option("--ring", o->ring_capacity, "ring capacity per stream (power of two)")->capture_default_str();
   cmd->callback([o, &exit_code] { exit_code = bench_latency(*o); });
 }

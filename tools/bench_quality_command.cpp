@@ -301,12 +301,15 @@ void print_low_rate(const std::vector<SmoothingRuns>& all, std::vector<std::stri
         std::printf("| %s | %s | %s / %s | %s | %s | %s | %s |\n", r.d->name.c_str(), r.d->sequences[s].name.c_str(),
                     fmt(raw.error_delivered).c_str(), fmt(raw.relative_error).c_str(), pct(def).c_str(), tuned("posefair").c_str(),
                     pct(r.score[r.index("one-euro-default")][s]).c_str(), tuned("one-euro").c_str());
-        std::string why;
-        if (def.error_delivered > 1.01 * raw.error_delivered) why += "absolute error more than 1% above raw; ";
-        if (!(def.relative_error < raw.relative_error)) why += "relative error not below raw; ";
-        if (oe && !(def.relative_error < r.score[*oe][s].relative_error)) why += "relative error not below One Euro tuned; ";
-        if (!why.empty())
-          losses.push_back("low rate, " + r.d->name + " " + r.d->sequences[s].name + ": " + why.substr(0, why.size() - 2));
+        std::vector<std::string_view> why;
+        if (def.error_delivered > 1.01 * raw.error_delivered) why.push_back("absolute error more than 1% above raw");
+        if (!(def.relative_error < raw.relative_error)) why.push_back("relative error not below raw");
+        if (oe && !(def.relative_error < r.score[*oe][s].relative_error)) why.push_back("relative error not below One Euro tuned");
+        if (!why.empty()) {
+          std::string line = "low rate, " + r.d->name + " " + r.d->sequences[s].name + ":";
+          for (std::size_t k = 0; k < why.size(); ++k) (line += k ? "; " : " ") += why[k];
+          losses.push_back(std::move(line));
+        }
       }
   }
   std::printf("\n");

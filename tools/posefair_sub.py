@@ -9,12 +9,15 @@ docs/protocol.md, which is the specification.
 
     python3 tools/posefair_sub.py --listen 0.0.0.0:5700 --format csv --count 1000
     python3 tools/posefair_sub.py --group 239.255.80.70 --interface eth0
+    python3 tools/posefair_sub.py --subscribe 127.0.0.1:5710 --streams 1,2 --encoding json
 
 The decoding functions (decode_binary, decode_json, decode) can be imported:
     from posefair_sub import decode, DecodeError
 """
 
 import argparse
+import hashlib
+import hmac
 import json
 import math
 import random
@@ -400,6 +403,131 @@ def format_csv(pose, received_at):
     return ",".join(fields) + "\n"
 
 
+# --- Subscribing (docs/protocol.md, "Subscribing") ----------------------------------------------
+SUB_MAGIC = b"PFS1"
+DEFAULT_CONTROL_PORT = 5710
+SUBSCRIBE, UNSUBSCRIBE = 1, 2
+COOKIE, SUBSCRIBED, UNSUBSCRIBED, REFUSED = 0x81, 0x82, 0x83, 0x84
+REQ_ANGULAR_VELOCITY, REQ_AUTHENTICATED = 1, 2
+REFUSE_REASONS = {1: "unknown-encoding", 2: "unknown-stream", 3: "too-many-subscribers", 4: "too-many-for-address"}
+# magic, type, flags, encoding length, stream count, request id, lease ms, cookie
+REQUEST = struct.Struct("<4sBBBBII16s")
+# magic, type, reason, reserved, request id, lease ms, cookie
+REPLY = struct.Struct("<4sBBHII16s")
+NO_COOKIE = bytes(16)
+
+
+def encode_request(kind, request_id, lease_ms=0, cookie=NO_COOKIE, encoding="", streams=(), angular_velocity=False,
+                   psk=None):
+    """A SUBSCRIBE or UNSUBSCRIBE; with psk (32 bytes), flagged and followed by its HMAC-SHA-512-256."""
+    flags = (REQ_ANGULAR_VELOCITY if angular_velocity else 0) | (REQ_AUTHENTICATED if psk else 0)
+    name = encoding.encode("ascii")
+    body = REQUEST.pack(SUB_MAGIC, kind, flags, len(name), len(streams), request_id, lease_ms, cookie)
+    body += name + b"".join(struct.pack("<I", s) for s in streams)
+    if psk:
+        body += hmac.new(psk, body, hashlib.sha512).digest()[:32]  # libsodium crypto_auth
+    return body
+
+
+def parse_reply(data):
+    """(type, reason, request id, lease ms, cookie), or None if data is not a reply."""
+    if len(data) != REPLY.size:
+        return None
+    magic, kind, reason, reserved, request_id, lease_ms, cookie = REPLY.unpack(data)
+    if magic != SUB_MAGIC or kind not in (COOKIE, SUBSCRIBED, UNSUBSCRIBED, REFUSED) or reserved or reason > 4:
+        return None
+    return kind, reason, request_id, lease_ms, cookie
+
+
+def first_request_id_now():
+    """Tenths of a second since 2025-01-01 UTC: above any id an earlier run on the same port used."""
+    return max(1, int(time.time() * 10) - 1735689600 * 10) & 0xFFFFFFFF
+
+
+class SubscriptionClient:
+    """The handshake as src/subscription_client.cpp does it: due() says what to send, on_reply() takes replies."""
+    RETRY = 0.3
+    MAX_TRIES = 10
+
+    def __init__(self, server, encoding, streams, lease_ms, angular_velocity, psk):
+        self.server = server
+        self.encoding, self.streams, self.lease_ms = encoding, streams, lease_ms
+        self.angular_velocity, self.psk = angular_velocity, psk
+        self.next_id = first_request_id_now()
+        self.awaiting = 0
+        self.state = "starting"
+        self.cookie = NO_COOKIE
+        self.next_send = 0.0
+        self.lease_end = 0.0
+        self.tries = 0
+        self.subscribed_once = False
+        self.granted_ms = 0
+        self.refused = None
+
+    def _request(self, kind, with_cookie):
+        self.awaiting = self.next_id
+        self.next_id = (self.next_id + 1) & 0xFFFFFFFF
+        cookie = self.cookie if with_cookie else NO_COOKIE
+        if kind == UNSUBSCRIBE:
+            return encode_request(kind, self.awaiting, 0, cookie, psk=self.psk)
+        return encode_request(kind, self.awaiting, self.lease_ms, cookie, self.encoding, self.streams,
+                              self.angular_velocity, self.psk)
+
+    def due(self, now):
+        if self.state in ("refused", "failed"):
+            return None
+        if self.state == "subscribed":
+            if now < self.next_send:
+                return None
+            self.state, self.tries = "starting", 0
+        if self.state == "starting":
+            self.state, self.next_send = "awaiting-cookie", now + self.RETRY
+            self.tries += 1
+            return self._request(SUBSCRIBE, False)
+        if now < self.next_send:
+            return None
+        if self.tries >= self.MAX_TRIES and (not self.subscribed_once or now >= self.lease_end):
+            self.state = "failed"
+            return None
+        self.tries += 1
+        self.next_send = now + self.RETRY
+        return self._request(SUBSCRIBE, self.state == "awaiting-subscribed")
+
+    def on_reply(self, data, source, now):
+        """True when data was the server's reply (consumed)."""
+        if source[:2] != self.server[:2]:
+            return False
+        reply = parse_reply(data)
+        if reply is None:
+            return False
+        kind, reason, request_id, lease_ms, cookie = reply
+        if request_id != self.awaiting:
+            return True
+        if kind == COOKIE:
+            self.cookie = cookie
+            if self.state in ("awaiting-cookie", "awaiting-subscribed"):
+                self.state, self.next_send = "awaiting-subscribed", now
+        elif kind == SUBSCRIBED:
+            self.state, self.subscribed_once, self.granted_ms, self.tries = "subscribed", True, lease_ms, 0
+            self.lease_end = now + lease_ms / 1000.0
+            self.next_send = now + lease_ms / 3000.0
+        elif kind == REFUSED:
+            self.state, self.refused = "refused", REFUSE_REASONS.get(reason, str(reason))
+        return True
+
+    def unsubscribe(self):
+        return self._request(UNSUBSCRIBE, True)
+
+
+def read_psk(path):
+    with open(path) as f:
+        text = f.read().strip()
+    key = bytes.fromhex(text)
+    if len(text) != 64 or len(key) != 32:
+        raise ValueError("not 64 hex digits")
+    return key
+
+
 # --- Sockets -------------------------------------------------------------------------------------
 def parse_endpoint(text, default_port=None):
     """'ADDR:PORT' or '[IPV6]:PORT' (numeric addresses only) -> (family, sockaddr) or None."""
@@ -524,8 +652,39 @@ def main(argv=None):
     ap.add_argument("--duration", type=_non_negative(float), default=0.0, help="exit after S seconds (0: no limit)")
     ap.add_argument("--quiet", action="store_true", help="print no poses, only the statistics")
     ap.add_argument("--stats", action="store_true", help="also print one line per (session, stream) at exit")
+    ap.add_argument("--subscribe", help="sign up on a daemon's subscription port HOST:PORT (default port %d) "
+                    "and keep the lease" % DEFAULT_CONTROL_PORT)
+    ap.add_argument("--streams", default="", help="with --subscribe: stream ids wanted, comma separated (default: all)")
+    ap.add_argument("--encoding", default="binary", help="with --subscribe: the encoding wanted (binary, json)")
+    ap.add_argument("--lease", type=float, default=30.0, help="with --subscribe: seconds of lease asked for")
+    ap.add_argument("--angular-velocity", action="store_true", help="with --subscribe: poses carry the body rate")
+    ap.add_argument("--psk-file", help="with --subscribe: the daemon's pre-shared key (64 hex digits)")
     args = ap.parse_args(argv)
     me = "posefair_sub.py"
+
+    client = None
+    if args.subscribe:
+        server = parse_endpoint(args.subscribe, DEFAULT_CONTROL_PORT)
+        try:
+            streams = [int(x) for x in args.streams.split(",") if x]
+        except ValueError:
+            streams = None
+        if server is None or streams is None or len(streams) > 16 or not 1 <= args.lease <= 86400:
+            sys.stderr.write("%s: bad --subscribe, --streams or --lease\n" % me)
+            return EXIT_USAGE
+        psk = None
+        if args.psk_file:
+            try:
+                psk = read_psk(args.psk_file)
+            except (OSError, ValueError):
+                sys.stderr.write("%s: --psk-file %s does not hold a key (64 hex digits)\n" % (me, args.psk_file))
+                return EXIT_USAGE
+        client = SubscriptionClient(server[1], args.encoding, streams, int(args.lease * 1000), args.angular_velocity, psk)
+        if args.listen is None:
+            args.listen = "[::]:0" if server[0] == socket.AF_INET6 else "0.0.0.0:0"
+    elif args.streams or args.psk_file or args.angular_velocity:
+        sys.stderr.write("%s: --streams, --psk-file and --angular-velocity need --subscribe\n" % me)
+        return EXIT_USAGE
 
     group = None
     if args.group:
@@ -570,9 +729,20 @@ def main(argv=None):
     stats = Stats()
     poses = 0
     deadline = time.monotonic() + args.duration if args.duration > 0 else None
+    status = EXIT_OK
     try:
         while not stop and (args.count == 0 or poses < args.count):
             wait = 0.2
+            if client is not None:
+                request = client.due(time.monotonic())
+                if request is not None:
+                    sock.sendto(request, client.server)
+                if client.state in ("refused", "failed"):
+                    why = "refused the subscription: %s" % client.refused if client.refused else "did not answer"
+                    sys.stderr.write("%s: %s %s\n" % (me, format_endpoint(listen[0], client.server), why))
+                    status = EXIT_UNAVAILABLE
+                    break
+                wait = 0.05
             if deadline is not None:
                 left = deadline - time.monotonic()
                 if left <= 0:
@@ -580,9 +750,16 @@ def main(argv=None):
                 wait = min(wait, left)
             sock.settimeout(wait)
             try:
-                data, _ = sock.recvfrom(65536)
+                data, source = sock.recvfrom(65536)
             except (socket.timeout, InterruptedError):
                 continue
+            if client is not None:
+                was = client.subscribed_once
+                if client.on_reply(data, source, time.monotonic()):
+                    if not was and client.subscribed_once:
+                        sys.stderr.write("%s: subscribed, lease %g s\n" % (me, client.granted_ms / 1000.0))
+                        sys.stderr.flush()
+                    continue
             received_at = time.time()
             try:
                 pose = decode(data)
@@ -600,6 +777,8 @@ def main(argv=None):
             else:
                 out.write(format_text(pose))
             out.flush()
+        if client is not None and client.subscribed_once:
+            unsubscribe(sock, client)
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)
@@ -609,7 +788,27 @@ def main(argv=None):
         for line in stats.stream_lines():
             sys.stderr.write(line + "\n")
     sys.stderr.write(stats.summary_line() + "\n")
-    return EXIT_OK
+    return status
+
+
+def unsubscribe(sock, client):
+    """UNSUBSCRIBE with the last cookie; once more with a fresh one if the daemon sends it."""
+    for _ in range(2):
+        sock.sendto(client.unsubscribe(), client.server)
+        until = time.monotonic() + 0.25
+        while time.monotonic() < until:
+            sock.settimeout(0.05)
+            try:
+                data, source = sock.recvfrom(65536)
+            except (socket.timeout, InterruptedError):
+                continue
+            reply = parse_reply(data) if source[:2] == client.server[:2] else None
+            if reply is None:
+                continue
+            if reply[0] == UNSUBSCRIBED:
+                return
+            client.on_reply(data, source, time.monotonic())
+            break
 
 
 if __name__ == "__main__":

@@ -22,15 +22,17 @@ packages=(
   zlib1g-dev             # CRC-32 of the sample log (drivers)
   libserialport-dev      # the serial driver: ports by path or USB id, settings (drivers)
   libnlopt-cxx-dev       # the quaternion spline optimiser (core)
-  nlohmann-json3-dev     # BROAD's trials.json (posefair bench fusion)
+  nlohmann-json3-dev     # BROAD's trials.json (posefair bench fusion), posefair ctl's JSON replies (tools)
   libgpiod-dev           # GPIO data-ready and scope lines, libgpiod 1.6 (drivers)
   liblo-dev              # OSC bundles of the vmc and vrchat output encodings (daemon)
   cyclonedds-dev cyclonedds-tools  # the dds output encoding: Cyclone DDS and its idlc (daemon)
+  libsodium-dev          # subscription cookies and pre-shared-key MACs (daemon)
+  iproute2 util-linux    # the attack tests' network namespaces and other users (ip, setpriv)
 )
 # The client encodings' independent peers (docs/outputs.md): oscdump receives the OSC
 # encodings, a Fast DDS reader (fastddsgen generates its type) the dds one.
 if [[ "${1:-}" == "--tests" ]]; then
-  packages+=(liblo-tools libfastrtps-dev fastddsgen iproute2 util-linux)
+  packages+=(liblo-tools libfastrtps-dev fastddsgen)
 fi
 # The hw tests' VM (tests/hw/vm/): Debian's own kernel under qemu, gpio-sim built against its
 # headers, and the tests' independent peers. Only amd64 boots that kernel.

@@ -10,6 +10,8 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -18,6 +20,8 @@
 
 #include "posefair/core/error.hpp"
 #include "posefair/daemon/json_lines.hpp"
+#include "posefair/daemon/output_encoder.hpp"
+#include "posefair/daemon/subscription_client.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 
 namespace posefair::tools {
@@ -169,6 +173,13 @@ struct SubOptions {
   std::uint64_t every = 1;    // print every N-th pose (statistics count all)
   bool quiet = false;
   bool stats = false;
+  // --subscribe: sign up on a daemon's subscription port instead of waiting for configured poses.
+  std::string subscribe;
+  std::vector<std::uint32_t> streams;
+  std::string encoding = "binary";
+  double lease = 30.0;
+  bool angular_velocity = false;
+  std::string psk_file;
 };
 
 volatile std::sig_atomic_t g_stop = 0;
@@ -228,8 +239,71 @@ void print_csv(const daemon::PoseMessage& m, std::chrono::system_clock::time_poi
   std::printf("\n");
 }
 
+// --subscribe and its options into a client; a usage error (64) as a message.
+std::optional<daemon::SubscriptionClient> make_client(const SubOptions& o, std::string& error) {
+  const auto server = daemon::Endpoint::parse(o.subscribe, daemon::kDefaultControlPort);
+  if (!server || server->is_unspecified() || server->is_multicast()) {
+    error = "--subscribe " + o.subscribe + " is not HOST:PORT or [IPV6]:PORT of a daemon's subscription port";
+    return std::nullopt;
+  }
+  if (!daemon::find_output_encoder(o.encoding)) {
+    error = "--encoding " + o.encoding + " is not a registered encoding";
+    return std::nullopt;
+  }
+  if (o.streams.size() > daemon::kMaxRequestStreams) {
+    error = "--streams lists more than " + std::to_string(daemon::kMaxRequestStreams) + " streams";
+    return std::nullopt;
+  }
+  std::optional<daemon::PreSharedKey> psk;
+  if (!o.psk_file.empty()) {
+    std::ifstream in(o.psk_file);
+    std::stringstream text;
+    text << in.rdbuf();
+    psk = daemon::parse_psk(text.str());
+    if (!in || !psk) {
+      error = "--psk-file " + o.psk_file + " does not hold a key (64 hex digits)";
+      return std::nullopt;
+    }
+  }
+  daemon::SubscriptionRequest r;
+  r.encoding = o.encoding;
+  r.streams = o.streams;
+  r.lease_ms = static_cast<std::uint32_t>(std::min(o.lease, 86400.0) * 1000.0);
+  r.angular_velocity = o.angular_velocity;
+  return daemon::SubscriptionClient(*server, r, psk, daemon::SubscriptionClient::first_request_id_now());
+}
+
+// Ends the lease at exit: UNSUBSCRIBE with the last cookie, once more if the daemon answers
+// with a fresh cookie; at most about half a second.
+void unsubscribe(daemon::UdpSocket& socket, daemon::SubscriptionClient& client, std::vector<std::uint8_t>& buffer) {
+  using namespace std::chrono;
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    socket.send_to(client.unsubscribe(), client.server());
+    const auto until = steady_clock::now() + milliseconds(250);
+    bool answered = false;
+    while (!answered && steady_clock::now() < until) {
+      const auto d = socket.receive(buffer, milliseconds(50));
+      if (!d || d->truncated || !(d->source == client.server())) continue;
+      const auto reply = daemon::parse_reply(std::span<const std::uint8_t>(buffer.data(), d->size));
+      if (!reply) continue;
+      if (reply->type == daemon::ReplyType::Unsubscribed) return;
+      client.on_reply(std::span<const std::uint8_t>(buffer.data(), d->size), d->source, steady_clock::now());
+      answered = true;  // a new cookie: try again with it
+    }
+  }
+}
+
 int run_sub(const SubOptions& o) {
   using namespace std::chrono;
+  std::optional<daemon::SubscriptionClient> client;
+  if (!o.subscribe.empty()) {
+    std::string error;
+    client = make_client(o, error);
+    if (!client) {
+      std::cerr << "posefair sub: " << error << "\n";
+      return exit_code(ErrorKind::Usage);
+    }
+  }
   // Addresses first: a malformed one is a usage error (64).
   std::optional<daemon::Endpoint> group;
   if (!o.group.empty()) {
@@ -241,6 +315,8 @@ int run_sub(const SubOptions& o) {
   }
   std::string listen_text = o.listen;
   if (group && group->family() == AF_INET6 && !o.listen_given) listen_text = "[::]:" + std::to_string(daemon::kDefaultPort);
+  // A subscriber listens where it asks from: any free port of the daemon's family.
+  if (client && !o.listen_given) listen_text = client->server().family() == AF_INET6 ? "[::]:0" : "0.0.0.0:0";
   const auto listen = daemon::Endpoint::parse(listen_text, daemon::kDefaultPort);
   if (!listen) {
     std::cerr << "posefair sub: --listen " << listen_text << " is not ADDR:PORT or [IPV6]:PORT\n";
@@ -284,8 +360,25 @@ int run_sub(const SubOptions& o) {
   std::vector<std::uint8_t> buffer(daemon::kMaxDatagramSize + 1);
   std::optional<steady_clock::time_point> last_datagram;
   const auto idle = duration_cast<steady_clock::duration>(duration<double>(o.idle));
+  const auto started = steady_clock::now();
+  int status = kExitOk;
   while (g_stop == 0 && (o.count == 0 || poses < o.count)) {
     milliseconds wait(200);
+    if (client) {
+      const auto now = steady_clock::now();
+      if (auto request = client->due(now)) socket.send_to(*request, client->server());
+      using State = daemon::SubscriptionClient::State;
+      if (client->state() == State::Refused || client->state() == State::Failed) {
+        if (client->state() == State::Refused)
+          std::cerr << "posefair sub: " << client->server().to_string() << " refused the subscription: "
+                    << daemon::to_string(client->refused_because()) << "\n";
+        else
+          std::cerr << "posefair sub: no answer from " << client->server().to_string() << "\n";
+        status = exit_code(ErrorKind::Unavailable);
+        break;
+      }
+      wait = milliseconds(50);
+    }
     if (deadline) {
       const auto left = *deadline - steady_clock::now();
       if (left <= steady_clock::duration::zero()) break;
@@ -298,6 +391,15 @@ int run_sub(const SubOptions& o) {
     }
     const auto d = socket.receive(buffer, wait);
     if (!d) continue;
+    if (client && !d->truncated) {
+      const bool was_subscribed = client->subscribed_once();
+      if (client->on_reply(std::span<const std::uint8_t>(buffer.data(), d->size), d->source, steady_clock::now())) {
+        if (!was_subscribed && client->subscribed_once())
+          std::cerr << "posefair sub: subscribed to " << client->server().to_string() << ", lease "
+                    << client->lease_ms() / 1000.0 << " s" << std::endl;
+        continue;
+      }
+    }
     last_datagram = steady_clock::now();
     if (d->truncated || d->size > daemon::kMaxDatagramSize) {
       stats.reject(daemon::DecodeError::kOversized);
@@ -309,7 +411,9 @@ int run_sub(const SubOptions& o) {
       continue;
     }
     stats.observe(r.message, d->received_at);
-    ++poses;
+    if (++poses == 1 && client)
+      std::cerr << "posefair sub: first pose " << duration<double, std::milli>(steady_clock::now() - started).count()
+                << " ms after the first SUBSCRIBE" << std::endl;
     if (o.quiet || (poses - 1) % o.every != 0) continue;
     if (csv)
       print_csv(r.message, d->received_at);
@@ -320,10 +424,11 @@ int run_sub(const SubOptions& o) {
     std::fflush(stdout);
   }
   std::fflush(stdout);
+  if (client && client->subscribed_once()) unsubscribe(socket, *client, buffer);
   if (o.stats)
     for (const auto& line : stats.stream_lines()) std::cerr << line << "\n";
   std::cerr << stats.summary_line() << std::endl;
-  return kExitOk;
+  return status;
 }
 
 }  // namespace
@@ -353,6 +458,20 @@ void add_sub_command(CLI::App& app, int& exit_code) {
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--quiet", o->quiet, "print no poses, only the statistics");
   cmd->add_flag("--stats", o->stats, "also print one statistics line per (session, stream) at exit");
+  auto* subscribe = cmd->add_option("--subscribe", o->subscribe,
+                                    "sign up on a daemon's subscription port HOST:PORT (default port 5710) and keep the lease");
+  cmd->add_option("--streams", o->streams, "with --subscribe: the stream ids wanted (default: every stream)")
+      ->delimiter(',')
+      ->needs(subscribe);
+  cmd->add_option("--encoding", o->encoding, "with --subscribe: the encoding wanted (binary, json)")
+      ->capture_default_str()
+      ->needs(subscribe);
+  cmd->add_option("--lease", o->lease, "with --subscribe: seconds of lease asked for (renewed at a third)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 86400.0))
+      ->needs(subscribe);
+  cmd->add_flag("--angular-velocity", o->angular_velocity, "with --subscribe: poses carry the body rate")->needs(subscribe);
+  cmd->add_option("--psk-file", o->psk_file, "with --subscribe: the daemon's pre-shared key (64 hex digits)")->needs(subscribe);
   cmd->callback([o, listen, &exit_code] {
     o->listen_given = listen->count() > 0;
     exit_code = run_sub(*o);

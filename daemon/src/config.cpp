@@ -127,7 +127,11 @@ bool before(const toml::source_position& a, const toml::source_position& b) {
   return a.line != b.line ? a.line < b.line : a.column < b.column;
 }
 
-constexpr std::string_view kRootKeys[] = {"daemon", "logging", "engine", "stream", "output", "recorder"};
+constexpr std::string_view kRootKeys[] = {"daemon", "logging", "engine", "stream", "output", "recorder", "subscription", "control"};
+constexpr std::string_view kSubscriptionKeys[] = {"enabled", "listen", "allow", "max_subscribers", "max_per_address",
+                                                  "rate_per_source", "burst_per_source", "source_table",
+                                                  "max_lease", "psk_file"};
+constexpr std::string_view kControlKeys[] = {"enabled", "socket", "mode", "group"};
 constexpr std::string_view kDaemonKeys[] = {"exit_when_sources_end", "session_id", "realtime_priority"};
 constexpr std::string_view kLoggingKeys[] = {"level", "target", "status_interval"};
 constexpr std::string_view kEngineKeys[] = {
@@ -349,6 +353,8 @@ class Parser {
         config.outputs.push_back(parse_output(outputs[i], element_key("output", i), config.streams));
     }
     if (const toml::node* n = root.get("recorder")) config.recorder = parse_recorder(table_of(*n, "recorder", "[recorder]"));
+    if (const toml::node* n = root.get("subscription")) config.subscription = parse_subscription(table_of(*n, "subscription", "[subscription]"));
+    if (const toml::node* n = root.get("control")) config.control = parse_control(table_of(*n, "control", "[control]"));
     return config;
   }
 
@@ -1399,6 +1405,70 @@ class Parser {
       if (!std::filesystem::is_directory(dir, ec)) fail(path_node, key("path"), "no such directory: " + dir.string());
     }
     return r;
+  }
+
+  // [subscription] (subscription_handler.hpp): absent or enabled = false, no port is opened.
+  std::optional<SubscriptionSettings> parse_subscription(const toml::table& t) const {
+    const std::string prefix = "subscription";
+    check_keys(t, prefix, kSubscriptionKeys);
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    if (const toml::node* n = t.get("enabled"); n && !get_bool(*n, key("enabled"))) return std::nullopt;
+    SubscriptionSettings s;
+    if (const toml::node* n = t.get("listen")) {
+      const std::string text = get_string(*n, key("listen"));
+      const auto e = Endpoint::parse(text, kDefaultControlPort);
+      if (!e || e->is_multicast())
+        fail(*n, key("listen"), "not a local address: " + in_quotes(text) + "; expected e.g. '127.0.0.1:5710' or '[::1]:5710'");
+      s.listen = *e;
+    }
+    if (const toml::node* n = t.get("allow")) {
+      if (!n->is_array()) wrong_type(*n, key("allow"), "an array of CIDR ranges");
+      std::vector<CidrRange> ranges;
+      const toml::array& a = *n->as_array();
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        const std::string k = element_key(key("allow"), i);
+        const std::string text = get_string(a[i], k);
+        const auto r = CidrRange::parse(text);
+        if (!r) fail(a[i], k, "not a CIDR range: " + in_quotes(text) + "; expected e.g. '192.168.1.0/24' or '::1/128'");
+        ranges.push_back(*r);
+      }
+      s.allow = AddressAllowList(std::move(ranges));
+    }
+    auto count = [&](std::string_view name, std::uint32_t& out, std::int64_t hi) {
+      if (const toml::node* n = t.get(name)) out = static_cast<std::uint32_t>(get_int(*n, key(name), 1, hi));
+    };
+    count("max_subscribers", s.max_subscribers, 4096);
+    count("max_per_address", s.max_per_address, 4096);
+    count("source_table", s.source_table, 1 << 20);
+    const FloatRange rate{0.0, true, 1e9, false};
+    if (const toml::node* n = t.get("rate_per_source")) s.rate_per_source = get_float(*n, key("rate_per_source"), rate);
+    if (const toml::node* n = t.get("burst_per_source")) s.burst_per_source = get_float(*n, key("burst_per_source"), FloatRange{1.0, false, 1e9, false});
+    if (const toml::node* n = t.get("max_lease")) s.max_lease = get_float(*n, key("max_lease"), FloatRange{1.0, false, 86400.0, false});
+    if (const toml::node* n = t.get("psk_file")) {
+      const std::filesystem::path path = resolve(get_nonempty_string(*n, key("psk_file")));
+      std::FILE* f = std::fopen(path.c_str(), "rb");
+      if (!f) fail(*n, key("psk_file"), "cannot read " + path.string() + ": " + std::strerror(errno));
+      char buf[256];
+      const std::size_t got = std::fread(buf, 1, sizeof buf, f);
+      std::fclose(f);
+      s.psk = parse_psk(std::string_view(buf, got));
+      if (!s.psk) fail(*n, key("psk_file"), path.string() + " does not hold a key: expected 64 hex digits (32 bytes)");
+    }
+    return s;
+  }
+
+  // [control] (ControlSocketConfig): absent or enabled = false, no socket is made.
+  std::optional<ControlSocketConfig> parse_control(const toml::table& t) const {
+    const std::string prefix = "control";
+    check_keys(t, prefix, kControlKeys);
+    auto key = [&](std::string_view name) { return join_key(prefix, name); };
+    if (const toml::node* n = t.get("enabled"); n && !get_bool(*n, key("enabled"))) return std::nullopt;
+    ControlSocketConfig c;
+    if (const toml::node* n = t.get("socket")) c.path = resolve(get_nonempty_string(*n, key("socket")));
+    if (const toml::node* n = t.get("mode")) c.mode = static_cast<std::uint32_t>(get_int(*n, key("mode"), 0, 0777));
+    if (const toml::node* n = t.get("group")) c.group = get_nonempty_string(*n, key("group"));
+    if (c.mode & 0007) fail(*t.get("mode"), key("mode"), "must give others no access (the socket reconfigures the daemon)");
+    return c;
   }
 
   std::string file_;

@@ -184,7 +184,8 @@ struct Pipeline::Stream final : drivers::SampleSink {
 };
 
 Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
-                   const std::map<std::uint32_t, std::uint64_t>& first_sequence, bool defer_recorder, PipelineHooks hooks)
+                   const std::map<std::uint32_t, std::uint64_t>& first_sequence, bool defer_recorder, PipelineHooks hooks,
+                   std::shared_ptr<SubscriberTable> subscribers)
     : config_(config), hooks_(std::move(hooks)) {
   const bool record = config_.recorder.enabled;
   std::vector<std::uint32_t> ids;
@@ -214,7 +215,7 @@ Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
     ids.push_back(sc.id);
     frames.push_back(sc.frame);
   }
-  publisher_ = std::make_unique<Publisher>(session, ids, config_.outputs, first_sequence, frames);
+  publisher_ = std::make_unique<Publisher>(session, ids, config_.outputs, first_sequence, frames, std::move(subscribers));
   if (record && !defer_recorder) {
     formats::SampleLogWriterOptions wo;
     wo.max_file_bytes = config_.recorder.max_file_bytes;
@@ -451,6 +452,10 @@ void Pipeline::recorder_loop() {
       Stream& s = *sp;
       RingSample r;
       while (s.record_ring->pop(r)) {
+        if (!recording_.load(std::memory_order_relaxed)) {
+          s.counters.record_paused.fetch_add(1, std::memory_order_relaxed);
+          continue;
+        }
         if (writer_) writer_->append(unpack(r));
         s.counters.recorded.fetch_add(1, std::memory_order_relaxed);
       }
@@ -487,7 +492,7 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.published = get(s.counters.published);
     st.send_failures = get(s.counters.send_failures);
     st.recorded = get(s.counters.recorded);
-    st.record_dropped = s.record_ring ? s.record_ring->dropped() : 0;
+    st.record_dropped = (s.record_ring ? s.record_ring->dropped() : 0) + get(s.counters.record_paused);
     st.latency = s.counters.latency.snapshot();
     st.device = s.driver->health();
     if (s.gpio.data_ready) st.data_ready = s.gpio.data_ready->counters();

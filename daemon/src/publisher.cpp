@@ -4,14 +4,16 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <system_error>
 
 
 namespace posefair::daemon {
 
 Publisher::Publisher(std::uint32_t session, std::vector<std::uint32_t> stream_ids,
                      const std::vector<OutputConfig>& outputs,
-                     const std::map<std::uint32_t, std::uint64_t>& first_sequence, const std::vector<StreamFrame>& frames)
-    : session_(session) {
+                     const std::map<std::uint32_t, std::uint64_t>& first_sequence, const std::vector<StreamFrame>& frames,
+                     std::shared_ptr<SubscriberTable> subscribers)
+    : session_(session), subscribers_(std::move(subscribers)) {
   streams_.resize(stream_ids.size());
   for (std::size_t i = 0; i < stream_ids.size(); ++i) {
     streams_[i].id = stream_ids[i];
@@ -24,17 +26,30 @@ Publisher::Publisher(std::uint32_t session, std::vector<std::uint32_t> stream_id
     for (std::uint32_t id : oc.streams)
       for (std::size_t i = 0; i < stream_ids.size(); ++i)
         if (stream_ids[i] == id) carries[i] = 1;
-    const auto shared = std::find_if(encoded_.begin(), encoded_.end(), [&](const Encoded& e) { return e.encoder == oc.encoder; });
-    const auto encoded = static_cast<std::size_t>(shared - encoded_.begin());
-    if (shared == encoded_.end()) {
-      Encoded e;
-      e.encoder = oc.encoder;
-      e.buffer.resize(kMaxDatagramSize);
-      encoded_.push_back(std::move(e));
-    }
-    outputs_.push_back(Output{encoded, oc.angular_velocity, std::move(carries), UdpSender(oc.destinations, oc.send),
+    outputs_.push_back(Output{encoded_index(oc.encoder), oc.angular_velocity, std::move(carries), UdpSender(oc.destinations, oc.send),
                               OutputRateLimit(oc.max_rate_hz, stream_ids.size())});
   }
+  if (subscribers_) {
+    for (const auto& encoder : subscribers_->encoders())  // an encoding not offered is never asked for
+      subscriber_encoded_.push_back(encoder ? encoded_index(encoder) : 0);
+    subscriber_view_ = subscribers_->make_view();
+    subscriber_v4_ = UdpSocket::open(AF_INET);
+    try {
+      subscriber_v6_ = UdpSocket::open(AF_INET6);
+    } catch (const std::system_error&) {
+      // a host without IPv6: IPv6 subscribers are counted as failed sends
+    }
+  }
+}
+
+std::size_t Publisher::encoded_index(const std::shared_ptr<const OutputEncoder>& encoder) {
+  const auto shared = std::find_if(encoded_.begin(), encoded_.end(), [&](const Encoded& e) { return e.encoder == encoder; });
+  if (shared != encoded_.end()) return static_cast<std::size_t>(shared - encoded_.begin());
+  Encoded e;
+  e.encoder = encoder;
+  e.buffer.resize(kMaxDatagramSize);
+  encoded_.push_back(std::move(e));
+  return encoded_.size() - 1;
 }
 
 Publisher::Result Publisher::publish(const RingPose& pose) {
@@ -64,22 +79,45 @@ Publisher::Result Publisher::publish(const RingPose& pose) {
     if (!out.carries[pose.stream_index]) continue;
     result.carried = true;
     if (!out.rate_limit.admit(pose.stream_index, pose.time)) continue;
-    m.angular_velocity = out.angular_velocity ? rate : std::nullopt;
-    const bool with_rate = m.angular_velocity.has_value();
-    Encoded& e = encoded_[out.encoded];
-    if (e.encoder->delivers()) {  // its own transport (DDS): no datagram, no destinations
-      if (!e.encoder->deliver(m)) ++result.failures;
+    const OutputEncoder& encoder = *encoded_[out.encoded].encoder;
+    if (encoder.delivers()) {  // its own transport (DDS): no datagram, no destinations
+      m.angular_velocity = out.angular_velocity ? rate : std::nullopt;
+      if (!encoder.deliver(m)) ++result.failures;
       continue;
     }
-    if (e.size == 0 || e.with_rate != with_rate) {
-      e.size = e.encoder->encode(m, e.buffer);
-      e.with_rate = with_rate;
-    }
-    const std::span<const std::uint8_t> datagram(e.buffer.data(), e.size);
-    const std::size_t sent = out.sender.send(datagram);
+    const std::size_t sent = out.sender.send(datagram(out.encoded, m, rate, out.angular_velocity));
     result.failures += out.sender.destinations().size() - sent;
   }
+  if (subscribers_) result.failures += publish_to_subscribers(m, rate);
   return result;
+}
+
+std::span<const std::uint8_t> Publisher::datagram(std::size_t index, PoseMessage& m, const std::optional<Vec3>& rate,
+                                                  bool with_rate) {
+  m.angular_velocity = with_rate ? rate : std::nullopt;
+  with_rate = m.angular_velocity.has_value();
+  Encoded& e = encoded_[index];
+  if (e.size == 0 || e.with_rate != with_rate) {
+    e.size = e.encoder->encode(m, e.buffer);
+    e.with_rate = with_rate;
+  }
+  return {e.buffer.data(), e.size};
+}
+
+std::size_t Publisher::publish_to_subscribers(PoseMessage& m, const std::optional<Vec3>& rate) {
+  subscribers_->refresh(subscriber_view_);
+  const auto now = static_cast<std::int64_t>(monotonic_ns());
+  std::size_t failures = 0;
+  for (std::size_t i = 0; i < subscriber_view_.count; ++i) {
+    const Subscriber& s = subscriber_view_.entries[i];
+    if (s.expires_ns <= now || !s.carries(m.stream)) continue;
+    UdpSocket& socket = s.address.family() == AF_INET6 ? subscriber_v6_ : subscriber_v4_;
+    if (socket.is_open() && socket.send_to(datagram(subscriber_encoded_[s.encoding], m, rate, s.angular_velocity), s.address))
+      subscribers_->count_sent(subscriber_view_.slot[i], 1);
+    else
+      ++failures;
+  }
+  return failures;
 }
 
 void Publisher::continue_from(const std::map<std::uint32_t, std::uint64_t>& next_sequence) {

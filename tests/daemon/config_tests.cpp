@@ -931,6 +931,62 @@ TEST(Config, TheDemoConfigReplaysTheBundledExcerpt) {
   EXPECT_EQ(replay.samples().front().stream_id, 1u);
 }
 
+TEST(Config, SubscriptionAndControlTables) {
+  testing::ScratchDir dir("posefair-config-");
+  write_file(dir.path() / "psk", "000102030405060708090a0b0c0d0e0f101112131415161718191a1b1c1d1e1f\n");
+  const DaemonConfig c = parse_config(R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[subscription]
+listen = "[::1]"
+allow = ["192.168.10.0/24", "fd00::/8", "10.1.2.3"]
+max_subscribers = 8
+max_per_address = 2
+rate_per_source = 5
+burst_per_source = 3
+source_table = 1024
+max_lease = 120
+psk_file = "psk"
+[control]
+socket = "ctl.sock"
+mode = 0o600
+group = "root"
+)",
+                                      dir.path() / "cfg.toml");
+  ASSERT_TRUE(c.subscription);
+  const SubscriptionSettings& s = *c.subscription;
+  EXPECT_EQ(s.listen.to_string(), "[::1]:5710");
+  ASSERT_EQ(s.allow.ranges().size(), 3u);
+  EXPECT_EQ(s.allow.ranges()[2].to_string(), "10.1.2.3/32");
+  EXPECT_EQ(s.max_subscribers, 8u);
+  EXPECT_EQ(s.max_per_address, 2u);
+  EXPECT_EQ(s.rate_per_source, 5.0);
+  EXPECT_EQ(s.burst_per_source, 3.0);
+  EXPECT_EQ(s.source_table, 1024u);
+  EXPECT_EQ(s.max_lease, 120.0);
+  ASSERT_TRUE(s.psk);
+  EXPECT_EQ((*s.psk)[31], 0x1f);
+  ASSERT_TRUE(c.control);
+  EXPECT_EQ(c.control->path, dir.path() / "ctl.sock");
+  EXPECT_EQ(c.control->mode, 0600u);
+  EXPECT_EQ(c.control->group, "root");
+  // Defaults: loopback only; and both off unless their table is there (or enabled = false).
+  const DaemonConfig d = parse_config("[[stream]]\nid = 1\nname = \"a\"\ndriver = { type = \"synthetic\" }\n"
+                                      "[subscription]\n[control]\n",
+                                      dir.path() / "cfg.toml");
+  EXPECT_EQ(d.subscription->listen.to_string(), "127.0.0.1:5710");
+  EXPECT_TRUE(d.subscription->allow.allows(*Endpoint::parse("127.0.0.1:1")));
+  EXPECT_FALSE(d.subscription->allow.allows(*Endpoint::parse("192.168.1.1:1")));
+  EXPECT_EQ(d.control->path, "/run/posefaird/control");
+  EXPECT_EQ(d.control->mode, 0660u);
+  const DaemonConfig off = parse_config("[[stream]]\nid = 1\nname = \"a\"\ndriver = { type = \"synthetic\" }\n"
+                                        "[subscription]\nenabled = false\n",
+                                        dir.path() / "cfg.toml");
+  EXPECT_FALSE(off.subscription);
+  EXPECT_FALSE(off.control);
+}
+
 struct BadConfig {
   const char* name;
   const char* toml;
@@ -1313,6 +1369,69 @@ driver = { type = "synthetic" }
 [recorder]
 sync = false
 )", "recorder.path: missing required key", 6},
+    {"subscription: listen not an address", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[subscription]
+listen = "localhost:5710"
+)", "subscription.listen: not a local address: 'localhost:5710'", 6},
+    {"subscription: allow not a CIDR range", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[subscription]
+allow = ["127.0.0.0/8", "10.0.0.0/40"]
+)", "subscription.allow[2]: not a CIDR range: '10.0.0.0/40'", 6},
+    {"subscription: cap of 0", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[subscription]
+max_subscribers = 0
+)", "subscription.max_subscribers: out of range: must be in [1, 4096], got 0", 6},
+    {"subscription: rate 0", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[subscription]
+rate_per_source = 0
+)", "subscription.rate_per_source: out of range", 6},
+    {"subscription: unknown key", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[subscription]
+max_leases = 10
+)", "subscription.max_leases: unknown key (did you mean 'max_lease'?)", 6},
+    {"subscription: missing key file", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[subscription]
+psk_file = "no-such.key"
+)", "subscription.psk_file: cannot read ", 6},
+    {"subscription: a key file without a key", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[subscription]
+psk_file = "poses.csv"
+)", "does not hold a key: expected 64 hex digits (32 bytes)", 6},
+    {"control: mode open to others", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[control]
+mode = 0o666
+)", "control.mode: must give others no access", 6},
+    {"control: empty socket path", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+[control]
+socket = ""
+)", "control.socket: must not be empty", 6},
     {"session id out of range", R"([daemon]
 session_id = -1
 [[stream]]

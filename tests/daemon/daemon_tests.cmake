@@ -13,7 +13,8 @@ posefair_add_test(pipeline_tests
 # --causal` against the daemon bit for bit, SIGHUP reloads (good and bad), SIGTERM while
 # recording and the replay of that recording, a truncated recording, malformed configs, and
 # `posefair sub --idle`, a serial device on a pseudo-terminal (a golden replay log, then an
-# unplug).
+# unplug); and (subscription_attack.cmake) attacks on the subscription port and the control
+# socket, each in a network namespace of its own.
 posefair_add_test(daemon_e2e_tests
   SOURCES daemon_e2e_tests.cpp
   LIBS posefair::protocol posefair::drivers posefair_replay_log

@@ -3,7 +3,8 @@
 // of the counting allocator in PipelineHooks::on_realtime_thread_start, the first thing it
 // does, and the test reads the slots after stop() has joined the threads (the slots are static
 // storage, so they outlive the threads). A JSON-lines output, which allocates a string per pose
-// on the publisher thread, shows that the slots do see those threads' allocations.
+// on the publisher thread, shows that the slots do see those threads' allocations. Sending to
+// subscribers of the subscription port (a table another thread keeps changing) is counted too.
 //
 // This binary links tests/support/counting_allocator.cpp, which replaces the global operator
 // new/delete: it must hold only allocation tests.
@@ -27,6 +28,8 @@
 #include "posefair/daemon/config.hpp"
 #include "posefair/daemon/fusion_stage.hpp"
 #include "posefair/daemon/pipeline.hpp"
+#include "posefair/daemon/ring_items.hpp"
+#include "posefair/daemon/subscriber_table.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/formats/sample_log.hpp"
 
@@ -87,7 +90,8 @@ struct PipelineRun {
 
 // Runs the pipeline until its source ends, stops it (which joins the engine and publisher
 // threads) and reads what each real-time thread allocated.
-PipelineRun run_pipeline(const std::string& driver, const std::string& solver, const std::string& encoding) {
+PipelineRun run_pipeline(const std::string& driver, const std::string& solver, const std::string& encoding,
+                         std::shared_ptr<SubscriberTable> subscribers = nullptr) {
   PipelineRun run;
   UdpCollector receiver;  // the output's destination; its thread claims no counter slot
   const DaemonConfig config =
@@ -96,7 +100,7 @@ PipelineRun run_pipeline(const std::string& driver, const std::string& solver, c
   // Stateless, so calling it allocates nothing; claiming a slot does not allocate either.
   hooks.on_realtime_thread_start = [] { counting::claim_counter_slot(); };
   {
-    Pipeline pipeline(config, kSession, {}, false, hooks);
+    Pipeline pipeline(config, kSession, {}, false, hooks, subscribers);
     pipeline.start();
     run.ended = wait_until([&] { return pipeline.sources_ended(); }, 30s);
     pipeline.stop();
@@ -325,6 +329,48 @@ TEST_F(PipelineAllocation, AJsonOutputAllocatesOnThePublisherThreadOnly) {
   EXPECT_EQ(run.stats.published, kDemoSamples);
   EXPECT_EQ(run.stats.send_failures, 0u);
   EXPECT_GT(run.datagrams, 0u);
+}
+
+}  // namespace
+}  // namespace posefair::daemon
+
+namespace posefair::daemon {
+namespace {
+
+// Subscribers (the subscription port's table) are sent to from the publisher thread too: with
+// one subscriber whose entry another thread keeps renewing, so the publisher copies the table
+// again and again, the real-time threads still allocate nothing.
+TEST_F(PipelineAllocation, SendingToSubscribersAllocatesNothingOnTheRealtimeThreads) {
+  UdpCollector subscriber;
+  auto table = std::make_shared<SubscriberTable>(8, 8);
+  Subscriber s;
+  s.address = *Endpoint::parse("127.0.0.1:" + std::to_string(subscriber.port()));
+  s.expires_ns = static_cast<std::int64_t>(monotonic_ns()) + 60'000'000'000;
+  s.last_request_id = 1;
+  ASSERT_EQ(table->subscribe(s), SubscriberTable::Outcome::Added);
+  std::atomic<bool> stop{false};
+  std::atomic<std::uint32_t> renewals{0};
+  std::thread renewing([&] {
+    Subscriber again = s;
+    while (!stop.load()) {
+      again.last_request_id = 2 + renewals.fetch_add(1);
+      table->subscribe(again);
+      std::this_thread::sleep_for(200us);
+    }
+  });
+  const PipelineRun run = run_pipeline(replay_driver(), "linear", "binary", table);
+  stop = true;
+  renewing.join();
+  subscriber.drain(100ms, 5s);
+  std::printf("%s; renewals %u, subscriber datagrams %zu\n", describe(run).c_str(), renewals.load(), subscriber.datagrams());
+  SCOPED_TRACE(describe(run));
+  EXPECT_TRUE(run.ended);
+  ASSERT_EQ(run.threads, 2);
+  for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
+  EXPECT_GT(renewals.load(), 10u);
+  EXPECT_EQ(run.stats.send_failures, 0u);
+  EXPECT_EQ(table->list().at(0).sent, kDemoSamples);
+  EXPECT_EQ(subscriber.datagrams(), kDemoSamples);
 }
 
 }  // namespace

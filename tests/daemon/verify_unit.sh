@@ -15,7 +15,8 @@ if [[ -n "$out" ]]; then
 fi
 for line in 'Type=notify' 'RestartPreventExitStatus=78' 'Restart=on-failure' 'WatchdogSec=' 'NoNewPrivileges=yes' \
             'ProtectSystem=strict' 'RestrictAddressFamilies=' 'DevicePolicy=closed' 'DeviceAllow=char-hidraw rw' \
-            'DeviceAllow=char-gpiochip rw' 'DeviceAllow=char-ttyUSB rw' 'User=posefair' 'ExecReload=/bin/kill -HUP $MAINPID'; do
+            'DeviceAllow=char-gpiochip rw' 'DeviceAllow=char-ttyUSB rw' 'User=posefair' 'ExecReload=/bin/kill -HUP $MAINPID' \
+            'RuntimeDirectory=posefaird' 'RuntimeDirectoryMode=0750'; do
   grep -qF -- "$line" "$unit_src" || { echo "missing from the unit: $line" >&2; exit 1; }
 done
 echo "unit ok"

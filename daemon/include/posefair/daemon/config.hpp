@@ -21,6 +21,7 @@
 #include "posefair/daemon/client_frames.hpp"
 #include "posefair/daemon/output_encoder.hpp"
 #include "posefair/daemon/overflow_policy.hpp"
+#include "posefair/daemon/subscription_handler.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
 #include "posefair/drivers/can_decoder.hpp"
@@ -220,6 +221,14 @@ struct RecorderConfig {
   std::uint32_t ring_capacity = 4096;  // per stream, samples waiting for the recorder thread
 };
 
+// [control]: the operators' Unix socket (`posefair ctl`, docs/operations.md). Access is by the
+// socket file's mode and group.
+struct ControlSocketConfig {
+  std::filesystem::path path = "/run/posefaird/control";
+  std::uint32_t mode = 0660;
+  std::string group;  // empty: the daemon's own group
+};
+
 struct DaemonConfig {
   std::filesystem::path source_file;  // the file this was loaded from
   DaemonSettings daemon;
@@ -227,6 +236,8 @@ struct DaemonConfig {
   std::vector<StreamConfig> streams;  // at least one
   std::vector<OutputConfig> outputs;  // may be empty (recording only)
   RecorderConfig recorder;
+  std::optional<SubscriptionSettings> subscription;  // [subscription]: clients sign up on a UDP port
+  std::optional<ControlSocketConfig> control;        // [control]: the Unix socket for posefair ctl
 };
 
 // Parses and validates a config file. Throws ConfigError (never anything else) for an

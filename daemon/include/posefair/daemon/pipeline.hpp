@@ -20,6 +20,7 @@
 
 #include "posefair/daemon/config.hpp"
 #include "posefair/daemon/stream_counters.hpp"
+#include "posefair/daemon/subscriber_table.hpp"
 #include "posefair/daemon/wake_signal.hpp"
 #include "posefair/formats/sample_log.hpp"
 
@@ -42,8 +43,9 @@ class Pipeline {
   // posefair::Error naming the stream or output: of kind Config (an unusable source, with the
   // stream's key) or CantCreate (the recording, key "recorder.path"); std::system_error for a
   // socket the OS refused. `session` and `first_sequence` continue the wire protocol across reloads.
+  // `subscribers`: the subscription port's table (may be null), which the publisher sends to too.
   Pipeline(const DaemonConfig& config, std::uint32_t session, const std::map<std::uint32_t, std::uint64_t>& first_sequence,
-           bool defer_recorder = false, PipelineHooks hooks = {});
+           bool defer_recorder = false, PipelineHooks hooks = {}, std::shared_ptr<SubscriberTable> subscribers = nullptr);
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
@@ -67,6 +69,10 @@ class Pipeline {
   void poke_engine();
 
   const DaemonConfig& config() const { return config_; }
+  // `posefair ctl record stop|start`: the recorder thread discards samples (counted as recorder
+  // drops) instead of writing them, or writes again. Only with a [recorder]; true at start.
+  void set_recording(bool on) { recording_.store(on, std::memory_order_relaxed); }
+  bool recording() const { return config_.recorder.enabled && recording_.load(std::memory_order_relaxed); }
   // Accepted damage in replay sources etc., to be logged once by the caller.
   const std::vector<std::string>& warnings() const { return warnings_; }
   // The recording's header (stream table) this pipeline writes or would write.
@@ -106,6 +112,7 @@ class Pipeline {
   std::atomic<bool> engine_stop_{false};
   std::atomic<bool> publisher_stop_{false};
   std::atomic<bool> recorder_stop_{false};
+  std::atomic<bool> recording_{true};
   std::atomic<int> drivers_running_{0};
   std::thread engine_thread_, publisher_thread_, recorder_thread_;
   std::vector<std::jthread> driver_threads_;

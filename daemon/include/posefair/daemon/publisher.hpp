@@ -18,6 +18,7 @@
 #include "posefair/daemon/output_encoder.hpp"
 #include "posefair/daemon/output_rate_limit.hpp"
 #include "posefair/daemon/ring_items.hpp"
+#include "posefair/daemon/subscriber_table.hpp"
 #include "posefair/daemon/udp_socket.hpp"
 #include "posefair/daemon/wire_protocol.hpp"
 
@@ -27,10 +28,12 @@ class Publisher {
  public:
   // `stream_ids[i]` is the wire id of stream index i. `first_sequence` gives, per wire stream
   // id, the sequence number to continue from (missing: 0). `frames[i]` is stream i's mounting and
-  // world correction (missing: none), applied before any encoding. Opens the sockets now;
-  // throws std::system_error when one cannot be opened.
+  // world correction (missing: none), applied before any encoding. `subscribers` (may be null):
+  // the clients that signed themselves up on the subscription port, sent to as well. Opens the
+  // sockets now; throws std::system_error when one cannot be opened.
   Publisher(std::uint32_t session, std::vector<std::uint32_t> stream_ids, const std::vector<OutputConfig>& outputs,
-            const std::map<std::uint32_t, std::uint64_t>& first_sequence, const std::vector<StreamFrame>& frames = {});
+            const std::map<std::uint32_t, std::uint64_t>& first_sequence, const std::vector<StreamFrame>& frames = {},
+            std::shared_ptr<SubscriberTable> subscribers = nullptr);
 
   struct Result {
     bool carried = false;           // at least one output carries this stream
@@ -68,10 +71,23 @@ class Publisher {
     double previous_time = 0.0;
     Quat previous = Quat::Identity();
   };
+  // The encoded_ entry of this encoder, added on first use (outputs sharing an encoder share it).
+  std::size_t encoded_index(const std::shared_ptr<const OutputEncoder>& encoder);
+  // The datagram of encoded_[index] for m, encoded on first use for this pose.
+  std::span<const std::uint8_t> datagram(std::size_t index, PoseMessage& m, const std::optional<Vec3>& rate, bool with_rate);
+  // Sends m to the subscribers that carry its stream and whose lease runs; returns failed sends.
+  std::size_t publish_to_subscribers(PoseMessage& m, const std::optional<Vec3>& rate);
+
   std::uint32_t session_;
   std::vector<Output> outputs_;
   std::vector<StreamState> streams_;
   std::vector<Encoded> encoded_;
+  // Subscribers (subscriber_table.hpp): the table, the publisher's own copy of its entries, the
+  // encoded_ index of each registered encoding, and a socket per family to send from.
+  std::shared_ptr<SubscriberTable> subscribers_;
+  SubscriberTable::View subscriber_view_;
+  std::vector<std::size_t> subscriber_encoded_;
+  UdpSocket subscriber_v4_, subscriber_v6_;
 };
 
 }  // namespace posefair::daemon

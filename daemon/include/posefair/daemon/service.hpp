@@ -8,6 +8,9 @@
 //                    fixed: then the session stays and sequences continue), a bad one is logged
 //                    and the running one kept;
 //   SIGUSR1          log every stream's counters now.
+// With [subscription] it also runs the subscription port (its own thread, kept across reloads),
+// and with [control] it answers the control socket on the main thread, polled with the signals
+// (a signalfd): status, streams, subscribers, counters, reload, record start|stop.
 // docs/operations.md describes it for operators. The exit status is exit_code() of the failure's
 // ErrorKind (core/error.hpp): Config (78) for a bad configuration or an unusable source, OsErr
 // (71) for a socket that cannot be opened, CantCreate (73) for a recording that cannot be

@@ -32,6 +32,7 @@ struct StreamCounters {
   std::atomic<std::uint64_t> published{0};        // poses sent to at least one destination (or to none configured)
   std::atomic<std::uint64_t> send_failures{0};    // failed sends (one per destination)
   std::atomic<std::uint64_t> recorded{0};         // handed to the recorder's writer
+  std::atomic<std::uint64_t> record_paused{0};     // discarded while `posefair ctl record stop` held
   LatencyHistogram latency;                       // hand-over → last datagram of the pose sent
   // The engine's state (FairingWindow::state()): the rate and window it settled on, and what
   // its adaptation measured and chose. Written by the engine thread after each batch.

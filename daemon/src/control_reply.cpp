@@ -1,0 +1,188 @@
+#include "posefair/daemon/control_reply.hpp"
+
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+
+namespace posefair::daemon {
+namespace {
+
+// Members appended one by one into one string (no chains of temporaries).
+class JsonObject {
+ public:
+  JsonObject& add(std::string_view name, std::string_view raw) {
+    if (!first_) text_ += ',';
+    first_ = false;
+    text_ += json_string(name);
+    text_ += ':';
+    text_ += raw;
+    return *this;
+  }
+  JsonObject& add(std::string_view name, std::uint64_t v) { return add(name, std::to_string(v)); }
+  JsonObject& add(std::string_view name, bool v) { return add(name, std::string_view(v ? "true" : "false")); }
+  JsonObject& number(std::string_view name, double v) { return add(name, json_number(v)); }
+  JsonObject& text(std::string_view name, std::string_view v) { return add(name, json_string(v)); }
+  std::string str() const { return text_ + "}"; }
+
+ private:
+  std::string text_ = "{";
+  bool first_ = true;
+};
+
+std::string channel(const ChannelAdaptation& c) {
+  return JsonObject()
+      .add("adaptive", c.adaptive)
+      .number("noise", c.noise)
+      .number("motion", c.motion)
+      .number("smoothing", c.smoothing)
+      .number("cutoff_hz", c.cutoff_hz)
+      .str();
+}
+
+std::string member(std::string_view name, const std::string& value) {
+  std::string out = json_string(name);
+  out += ':';
+  out += value;
+  return out;
+}
+
+}  // namespace
+
+std::string json_string(std::string_view s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += ch;
+    }
+  }
+  out += '"';
+  return out;
+}
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+std::string control_error_reply(const std::string& message, ErrorKind kind) {
+  return JsonObject().add("ok", false).text("error", message).add("exit", static_cast<std::uint64_t>(exit_code(kind))).str();
+}
+
+std::string streams_member(const std::vector<StreamStats>& now, const std::vector<StreamStats>& previous, double seconds) {
+  std::string list = "[";
+  for (std::size_t i = 0; i < now.size(); ++i) {
+    const StreamStats& s = now[i];
+    std::string rate = "null";
+    for (const StreamStats& p : previous)
+      if (p.id == s.id && seconds > 0) rate = json_number(static_cast<double>(s.emitted - p.emitted) / seconds);
+    const HistogramSnapshot& l = s.latency;
+    const auto us = [&](double p) { return l.count ? json_number(static_cast<double>(l.percentile(p)) / 1000.0) : "null"; };
+    const std::string latency = JsonObject()
+                                    .add("p50", us(50))
+                                    .add("p90", us(90))
+                                    .add("p99", us(99))
+                                    .add("max", l.count ? json_number(static_cast<double>(l.max) / 1000.0) : "null")
+                                    .str();
+    const std::string engine = JsonObject()
+                                   .number("rate_hz", s.engine.rate_hz)
+                                   .add("window", std::to_string(s.engine.window))
+                                   .add("rotation", channel(s.engine.rotation))
+                                   .add("position", channel(s.engine.position))
+                                   .str();
+    if (i) list += ',';
+    list += JsonObject()
+                .add("id", std::uint64_t{s.id})
+                .text("name", s.name)
+                .text("driver", s.driver)
+                .add("running", s.driver_running)
+                .add("rate_hz", rate)
+                .add("received", s.received)
+                .add("emitted", s.emitted)
+                .add("dropped", s.dropped())
+                .add("ring_dropped", s.ring_dropped)
+                .add("publish_dropped", s.publish_dropped)
+                .add("rejected", s.rejected)
+                .add("out_of_order", s.out_of_order)
+                .add("clamped", s.clamped)
+                .add("restarts", s.restarts)
+                .add("published", s.published)
+                .add("send_failures", s.send_failures)
+                .add("recorded", s.recorded)
+                .add("record_dropped", s.record_dropped)
+                .add("latency_us", latency)
+                .add("engine", engine)
+                .str();
+  }
+  list += ']';
+  return member("streams", list);
+}
+
+std::string subscribers_member(const std::vector<SubscriberTable::Listed>& list, std::int64_t now_ns) {
+  const auto entries = output_encoder_entries();
+  std::string out = "[";
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const Subscriber& s = list[i].subscriber;
+    std::string streams = "[";
+    for (std::size_t k = 0; k < s.stream_count; ++k) {
+      if (k) streams += ',';
+      streams += std::to_string(s.streams[k]);
+    }
+    streams += ']';
+    const std::string_view encoding = s.encoding < entries.size() ? entries[s.encoding]->name : "?";
+    if (i) out += ',';
+    out += JsonObject()
+               .text("address", s.address.to_string())
+               .text("encoding", encoding)
+               .add("streams", streams)
+               .add("angular_velocity", s.angular_velocity)
+               .number("lease_left_s", static_cast<double>(s.expires_ns - now_ns) / 1e9)
+               .number("subscribed_s", static_cast<double>(now_ns - s.since_ns) / 1e9)
+               .add("sent", list[i].sent)
+               .str();
+  }
+  out += ']';
+  return member("subscribers", out);
+}
+
+std::string subscription_member(const SubscriptionHandler& handler, std::size_t subscribers) {
+  const SubscriptionCounters& c = handler.counters();
+  const auto get = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
+  const double in = static_cast<double>(get(c.unverified_bytes_in));
+  const double out = static_cast<double>(get(c.unverified_bytes_out));
+  return member("subscription", JsonObject()
+                                    .text("listen", handler.settings().listen.to_string())
+                                    .add("subscribers", std::uint64_t{subscribers})
+                                    .add("capacity", std::uint64_t{handler.settings().max_subscribers})
+                                    .add("authenticated", handler.settings().psk.has_value())
+                                    .add("datagrams", get(c.datagrams))
+                                    .add("bytes_in", get(c.bytes_in))
+                                    .add("bytes_out", get(c.bytes_out))
+                                    .add("not_allowed", get(c.not_allowed))
+                                    .add("rate_limited", get(c.rate_limited))
+                                    .add("malformed", get(c.malformed))
+                                    .add("unauthenticated", get(c.unauthenticated))
+                                    .add("cookies_sent", get(c.cookies_sent))
+                                    .add("bad_cookie", get(c.bad_cookie))
+                                    .add("subscribed", get(c.subscribed))
+                                    .add("renewed", get(c.renewed))
+                                    .add("replayed", get(c.replayed))
+                                    .add("unsubscribed", get(c.unsubscribed))
+                                    .add("refused", get(c.refused))
+                                    .add("expired", get(c.expired))
+                                    .add("unverified_bytes_in", get(c.unverified_bytes_in))
+                                    .add("unverified_bytes_out", get(c.unverified_bytes_out))
+                                    .add("amplification", in > 0 ? json_number(out / in) : "null")
+                                    .str());
+}
+
+}  // namespace posefair::daemon
