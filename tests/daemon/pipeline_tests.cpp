@@ -77,6 +77,25 @@ std::vector<double> demo_times() {
   return f.poses().time;
 }
 
+// A sample log of one stream (id 1, "imu") holding `samples`.
+void write_imu_log(const std::filesystem::path& path, const std::vector<Sample>& samples) {
+  formats::SampleLogHeader h;
+  h.streams = {{1, "imu", "test"}};
+  formats::SampleLogWriterOptions o;
+  o.sync = false;
+  formats::SampleLogWriter w(path, h, o);
+  for (const Sample& s : samples) ASSERT_TRUE(w.append(s));
+}
+
+// Runs a one-stream pipeline until its source ends; that stream's counters.
+StreamStats run_to_end(const DaemonConfig& config) {
+  Pipeline pipeline(config, kSession, {}, false, {});
+  pipeline.start();
+  EXPECT_TRUE(wait_until([&] { return pipeline.sources_ended(); }, 30s)) << "the source did not end";
+  pipeline.stop();
+  return pipeline.stats().at(0);
+}
+
 struct SlowRun {
   StreamStats stats;
   std::uint64_t hook_calls = 0;
@@ -183,14 +202,7 @@ void check_publishing(const SlowRun& run) {
 TEST(Pipeline, ReplayWithALargeRingLosesNothing) {
   UdpCollector receiver;
   const DaemonConfig config = parse_config(replay_config(receiver.port(), 4096, "drop-oldest"), "/virtual/big.toml");
-  StreamStats s;
-  {
-    Pipeline pipeline(config, kSession, {}, false, {});
-    pipeline.start();
-    ASSERT_TRUE(wait_until([&] { return pipeline.sources_ended(); }, 30s));
-    pipeline.stop();
-    s = pipeline.stats().at(0);
-  }
+  const StreamStats s = run_to_end(config);
   EXPECT_EQ(s.received, kDemoSamples);
   EXPECT_EQ(s.ring_dropped, 0u);
   EXPECT_EQ(s.emitted, kDemoSamples);
@@ -402,14 +414,7 @@ TEST(Pipeline, RawOnlySamplesAreCountedNotFairedAndRecordedWithTheirReadings) {
     s.gyro = s.flags ? Vec3(0, 0, 1.0) : Vec3::Zero();
     s.accel = s.flags ? Vec3(0.1, 0, 9.81) : Vec3::Zero();
   }
-  {
-    formats::SampleLogHeader h;
-    h.streams = {{1, "imu", "test"}};
-    formats::SampleLogWriterOptions o;
-    o.sync = false;
-    formats::SampleLogWriter w(dir / "in.pflog", h, o);
-    for (const Sample& s : recorded) ASSERT_TRUE(w.append(s));
-  }
+  write_imu_log(dir / "in.pflog", recorded);
   UdpCollector receiver;
   const std::string text = "[[stream]]\nid = 1\nname = \"imu\"\n[stream.driver]\ntype = \"replay\"\npath = \"" +
                            (dir / "in.pflog").string() +
@@ -417,14 +422,7 @@ TEST(Pipeline, RawOnlySamplesAreCountedNotFairedAndRecordedWithTheirReadings) {
                            "[recorder]\npath = \"" + (dir / "out.pflog").string() + "\"\nsync = false\n\n"
                            "[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(receiver.port()) + "\"]\n";
   const DaemonConfig config = parse_config(text, "/virtual/raw.toml");
-  StreamStats s;
-  {
-    Pipeline pipeline(config, kSession, {}, false, {});
-    pipeline.start();
-    ASSERT_TRUE(wait_until([&] { return pipeline.sources_ended(); }, 30s));
-    pipeline.stop();
-    s = pipeline.stats().at(0);
-  }
+  const StreamStats s = run_to_end(config);
   EXPECT_EQ(s.received, 300u);
   EXPECT_EQ(s.raw_unfused, 100u);
   EXPECT_EQ(s.rejected + s.out_of_order + s.ring_dropped, 0u);
@@ -480,14 +478,7 @@ TEST(Pipeline, RawSamplesWithAFusionStageAreFusedFairedAndPublished) {
     s.accel = q.conjugate() * gravity;
     s.mag = q.conjugate() * field;
   }
-  {
-    formats::SampleLogHeader h;
-    h.streams = {{1, "imu", "test"}};
-    formats::SampleLogWriterOptions o;
-    o.sync = false;
-    formats::SampleLogWriter w(dir / "in.pflog", h, o);
-    for (const Sample& s : recorded) ASSERT_TRUE(w.append(s));
-  }
+  write_imu_log(dir / "in.pflog", recorded);
   UdpCollector receiver;
   const std::string text = "[[stream]]\nid = 1\nname = \"imu\"\nring_capacity = 4096\n"
                            "[stream.driver]\ntype = \"replay\"\npath = \"" +
@@ -496,14 +487,7 @@ TEST(Pipeline, RawSamplesWithAFusionStageAreFusedFairedAndPublished) {
                            "[recorder]\npath = \"" + (dir / "out.pflog").string() + "\"\nsync = false\n\n"
                            "[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(receiver.port()) + "\"]\n";
   const DaemonConfig config = parse_config(text, "/virtual/fused.toml");
-  StreamStats s;
-  {
-    Pipeline pipeline(config, kSession, {}, false, {});
-    pipeline.start();
-    ASSERT_TRUE(wait_until([&] { return pipeline.sources_ended(); }, 30s));
-    pipeline.stop();
-    s = pipeline.stats().at(0);
-  }
+  const StreamStats s = run_to_end(config);
   EXPECT_EQ(s.received, kCount);
   EXPECT_EQ(s.raw_unfused, 0u);
   EXPECT_EQ(s.fusion_waiting, 0u) << "every sample has an accelerometer reading";
