@@ -234,7 +234,7 @@ TEST(SocketCanDriver, KernelFiltersKeepForeignFramesOffTheSocket) {
   const std::uint8_t bytes[8] = {1, 2, 3, 4, 5, 6, 7, 8};
   for (int k = 0; k < 10; ++k) {
     sender.send_all({CanFrame::make(0x123, false, bytes), CanFrame::make(0x7FF, false, bytes),
-                     CanFrame::make(0x203, false, bytes), CanFrame::make(0x202, true, bytes)});  // B+3; B+2 as 29-bit
+                     CanFrame::make(0x204, false, bytes), CanFrame::make(0x202, true, bytes)});  // B+4; B+2 as 29-bit
     sender.send_all(posefair_quaternion(0.01 * k));
   }
   ASSERT_TRUE(wait_until([&] { return r.samples.size() >= 10; }, 10s)) << log.text();
