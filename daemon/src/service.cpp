@@ -16,6 +16,7 @@
 #include <cinttypes>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <system_error>
@@ -180,6 +181,7 @@ class Service {
       if (watchdog && hb != heartbeat_at_poke) notify("WATCHDOG=1");
       heartbeat_at_poke = hb;
       pipeline_->poke_engine();
+      log_recorder_change();
 
       const auto now = Clock::now();
       if (now - last_status_ >= std::chrono::seconds(1)) {
@@ -204,6 +206,21 @@ class Service {
 
  private:
   static double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+  // One line when the recording stops being written (disk full, I/O error), one when it writes
+  // again: the recorder thread only sets the state, the main thread logs it.
+  void log_recorder_change() {
+    const int error = pipeline_->recorder_errno();
+    if (error == recorder_errno_) return;
+    const std::string path = pipeline_->config().recorder.path.string();
+    if (error != 0)
+      spdlog::error("recording {}: cannot write: {}; publishing continues, samples that no longer fit the "
+                    "recorder's buffer are counted as recorder drops until a write succeeds",
+                    path, std::strerror(error));
+    else
+      spdlog::info("recording {}: writing again", path);
+    recorder_errno_ = error;
+  }
 
   void mark_interval() {
     last_status_ = Clock::now();
@@ -362,6 +379,7 @@ class Service {
   std::unique_ptr<Pipeline> pipeline_;
   Clock::time_point last_status_, last_log_;
   std::vector<StreamStats> last_status_stats_, last_log_stats_;
+  int recorder_errno_ = 0;  // as last logged
 };
 
 }  // namespace
