@@ -772,25 +772,29 @@ class Soak:
             worst = max([worst] + [b - a_ for a_, b in zip(points, points[1:])])
         check(worst < a.watchdog_usec / 1e6, "watchdog: never missed",
               f"longest interval between WATCHDOG=1 {worst:.2f} s (WATCHDOG_USEC {a.watchdog_usec / 1e6:.0f} s)")
-        # Leaks: RSS and descriptors of the daemon that ran longest, at the quiet phases after the
-        # first one (warm-up: every code path has run once).
+        # Leaks: RSS and descriptors of the last daemon at the end of every phase from the end of
+        # its first SIGHUP phase on. That phase is the warm-up: the first reloads free the first
+        # pipeline's rings and glibc's malloc raises its mmap threshold, so the next pipelines'
+        # rings stay in the heap (RSS steps up once, then stays).
         last = self.daemons[-1]
-        quiet = [(ph[0], ph[2]) for ph in self.phases if ph[0] in ("baseline", "tail") and ph[2]]
+        ends = [ph[2] for ph in self.phases if ph[2]]
+        first_hup = next((ph[2] for ph in self.phases if ph[0] == "sighup" and ph[2]), None)
         points = []
-        for name, t in quiet:
-            s = [x for x in self.monitor.samples if x[2] == last.pid and x[0] <= t]
-            if s:
-                points.append((name, s[-1][3], s[-1][4]))
+        for t in ends:
+            s_ = [x for x in self.monitor.samples if x[2] == last.pid and x[0] <= t]
+            if s_ and first_hup is not None and t >= first_hup and (last.ended is None or t < last.ended):
+                points.append((s_[-1][3], s_[-1][4]))
         if len(points) >= 2:
-            rss0, fd0 = points[0][1], points[0][2]
-            growth = points[-1][1] - rss0
-            fds = [p[2] for p in points]
-            limit = 8192 if a.asan else 2048
-            check(all(f == fd0 for f in fds), "leaks: open descriptors flat after warm-up", f"{fds}")
-            check(growth <= limit, "leaks: RSS flat after warm-up",
-                  f"{rss0} KiB -> {points[-1][1]} KiB ({growth:+d} KiB over {len(points)} quiet points, limit {limit})")
+            growth = points[-1][0] - points[0][0]
+            fds = [p_[1] for p_ in points]
+            check(all(f == fds[0] for f in fds), "leaks: open descriptors flat after warm-up", f"{fds}")
+            detail = f"{points[0][0]} KiB -> {points[-1][0]} KiB ({growth:+d} KiB over {len(points)} phase ends)"
+            if a.asan:  # ASan's quarantine grows the RSS by design; LeakSanitizer checks at the exit
+                print(f"  [INFO] leaks: RSS under ASan (not judged; LeakSanitizer runs at the exit): {detail}")
+            else:
+                check(growth <= 2048, "leaks: RSS flat after warm-up (at most 2 MiB growth)", detail)
         else:
-            check(False, "leaks: at least two quiet points sampled", str(points))
+            check(False, "leaks: at least two phase ends sampled after warm-up", str(points))
         # Latency and drops per fault: the daemon's STATUS= p99 of each second, per stream.
         print("\n| phase | s | load avg | datagrams/s | p99 per second, median / max (µs) | ring drops | publish drops | recorder drops | RSS KiB, fds at the end |")
         print("|---|---|---|---|---|---|---|---|---|")

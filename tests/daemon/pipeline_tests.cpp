@@ -459,7 +459,7 @@ TEST(Pipeline, RawOnlySamplesAreCountedNotFairedAndRecordedWithTheirReadings) {
 TEST(Pipeline, ARecordingThatCannotBeWrittenCountsItsDropsAndResumes) {
   ScratchDir dir;
   const std::string text = "[[stream]]\nid = 1\nname = \"fast\"\n"
-                           "driver = { type = \"synthetic\", rate_hz = 20000.0, duration = 3.0 }\n\n"
+                           "driver = { type = \"synthetic\", rate_hz = 20000.0, duration = 1.0 }\n\n"
                            "[recorder]\npath = \"" + (dir / "out.pflog").string() +
                            "\"\nsync = false\nflush_interval = 0.05\n";
   const DaemonConfig config = parse_config(text, "/virtual/full.toml");
