@@ -193,7 +193,30 @@ class SerialDevices:
 # ------------------------------------------------------------------------------------------------
 # The receiver: every datagram of the configured output, every sequence number checked
 
-class Receiver:
+class SocketReader:
+    """A thread that hands every datagram of `sock` and its ancillary data to handle()."""
+
+    def __init__(self, sock, size, ancillary):
+        self.sock, self.size, self.ancillary = sock, size, ancillary
+        self.sock.settimeout(0.2)
+        self.stop = False
+        self.thread = threading.Thread(target=self.run, daemon=True)
+        self.thread.start()
+
+    def run(self):
+        while not self.stop:
+            try:
+                data, anc, _, _ = self.sock.recvmsg(self.size, self.ancillary)
+            except socket.timeout:
+                continue
+            self.handle(data, anc)
+
+    def close(self):
+        self.stop = True
+        self.thread.join()
+
+
+class Receiver(SocketReader):
     HEADER = struct.Struct("<4sBBHIIQdd")
 
     def __init__(self, phase):
@@ -205,84 +228,67 @@ class Receiver:
             self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 32 << 20)
         self.sock.setsockopt(socket.SOL_SOCKET, SO_RXQ_OVFL, 1)
         self.sock.bind(("127.0.0.1", 0))
-        self.sock.settimeout(0.2)
         self.port = self.sock.getsockname()[1]
         self.streams = {}  # (session, stream) -> dict
         self.per_phase = {}  # phase -> dict(datagrams, max sample gap, send offsets)
         self.overflow = 0  # datagrams the kernel dropped at this socket (SO_RXQ_OVFL)
         self.malformed = 0
-        self.stop = False
-        self.thread = threading.Thread(target=self.run, daemon=True)
-        self.thread.start()
+        super().__init__(self.sock, 2048, socket.CMSG_SPACE(4))
 
-    def run(self):
-        while not self.stop:
-            try:
-                data, anc, _, _ = self.sock.recvmsg(2048, socket.CMSG_SPACE(4))
-            except socket.timeout:
-                continue
-            for level, kind, value in anc:
-                if level == socket.SOL_SOCKET and kind == SO_RXQ_OVFL and len(value) >= 4:
-                    self.overflow = struct.unpack("<I", value[:4])[0]
-            if len(data) < 56 or data[:4] != b"PFP1":
-                self.malformed += 1
-                continue
-            _, _, _, _, session, stream, seq, sample_time, send_time = self.HEADER.unpack_from(data)
-            now = time.time()
-            ph = self.per_phase.setdefault(self.phase[0], {"datagrams": 0, "max_gap": 0.0, "offset_min": 0.0, "offset_max": 0.0})
-            ph["datagrams"] += 1
-            offset = send_time - now
-            ph["offset_min"] = min(ph["offset_min"], offset)
-            ph["offset_max"] = max(ph["offset_max"], offset)
-            s = self.streams.get((session, stream))
-            if s is None:
-                self.streams[(session, stream)] = {"first": seq, "last": seq, "count": 1, "gaps": 0, "back": 0,
-                                                    "time": sample_time, "time_back": 0}
-                continue
-            s["count"] += 1
-            if seq > s["last"]:
-                s["gaps"] += seq - s["last"] - 1
-                s["last"] = seq
-            else:
-                s["back"] += 1  # a duplicate or a reordered datagram
-            if sample_time <= s["time"]:
-                s["time_back"] += 1
-            elif stream in SYNTHETIC:
-                ph["max_gap"] = max(ph["max_gap"], sample_time - s["time"])
-            s["time"] = max(s["time"], sample_time)
+    def handle(self, data, anc):
+        for level, kind, value in anc:
+            if level == socket.SOL_SOCKET and kind == SO_RXQ_OVFL and len(value) >= 4:
+                self.overflow = struct.unpack("<I", value[:4])[0]
+        if len(data) < 56 or data[:4] != b"PFP1":
+            self.malformed += 1
+            return
+        _, _, _, _, session, stream, seq, sample_time, send_time = self.HEADER.unpack_from(data)
+        now = time.time()
+        ph = self.per_phase.setdefault(self.phase[0], {"datagrams": 0, "max_gap": 0.0, "offset_min": 0.0, "offset_max": 0.0})
+        ph["datagrams"] += 1
+        offset = send_time - now
+        ph["offset_min"] = min(ph["offset_min"], offset)
+        ph["offset_max"] = max(ph["offset_max"], offset)
+        s = self.streams.get((session, stream))
+        if s is None:
+            self.streams[(session, stream)] = {"first": seq, "last": seq, "count": 1, "gaps": 0, "back": 0,
+                                                "time": sample_time, "time_back": 0}
+            return
+        s["count"] += 1
+        if seq > s["last"]:
+            s["gaps"] += seq - s["last"] - 1
+            s["last"] = seq
+        else:
+            s["back"] += 1  # a duplicate or a reordered datagram
+        if sample_time <= s["time"]:
+            s["time_back"] += 1
+        elif stream in SYNTHETIC:
+            ph["max_gap"] = max(ph["max_gap"], sample_time - s["time"])
+        s["time"] = max(s["time"], sample_time)
 
     def close(self):
         time.sleep(0.5)  # the datagrams still in flight (the daemon has stopped)
-        self.stop = True
-        self.thread.join()
+        super().close()
 
 
 # ------------------------------------------------------------------------------------------------
 # The notify socket: READY=1, WATCHDOG=1, STATUS=... with the sender's pid (SO_PASSCRED)
 
-class NotifySocket:
+class NotifySocket(SocketReader):
     def __init__(self, path, phase):
         self.phase = phase
-        self.sock = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
-        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_PASSCRED, 1)
-        self.sock.bind(path)
-        self.sock.settimeout(0.2)
         self.messages = []  # (monotonic time, pid, phase, text)
-        self.stop = False
-        self.thread = threading.Thread(target=self.run, daemon=True)
-        self.thread.start()
+        sock = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_PASSCRED, 1)
+        sock.bind(path)
+        super().__init__(sock, 8192, socket.CMSG_SPACE(12))
 
-    def run(self):
-        while not self.stop:
-            try:
-                data, anc, _, _ = self.sock.recvmsg(8192, socket.CMSG_SPACE(12))
-            except socket.timeout:
-                continue
-            pid = 0
-            for level, kind, value in anc:
-                if level == socket.SOL_SOCKET and kind == socket.SCM_CREDENTIALS:
-                    pid = struct.unpack("<iII", value[:12])[0]
-            self.messages.append((time.monotonic(), pid, self.phase[0], data.decode(errors="replace")))
+    def handle(self, data, anc):
+        pid = 0
+        for level, kind, value in anc:
+            if level == socket.SOL_SOCKET and kind == socket.SCM_CREDENTIALS:
+                pid = struct.unpack("<iII", value[:12])[0]
+        self.messages.append((time.monotonic(), pid, self.phase[0], data.decode(errors="replace")))
 
     def wait_for(self, pid, text, timeout):
         deadline = time.monotonic() + timeout
@@ -292,9 +298,6 @@ class NotifySocket:
             time.sleep(0.05)
         return False
 
-    def close(self):
-        self.stop = True
-        self.thread.join()
 
 
 # ------------------------------------------------------------------------------------------------
