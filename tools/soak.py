@@ -742,13 +742,20 @@ class Soak:
             time.sleep(2.5)
         c1 = self.counters()
         ph = self.receiver.per_phase.get("clock-step", {})
-        moved = sum(c1[i]["restarts"] - c0[i]["restarts"] + c1[i]["out_of_order"] - c0[i]["out_of_order"] for i in SYNTHETIC)
+        both = [i for i in SYNTHETIC if i in c0 and i in c1]
+        moved = sum(c1[i]["restarts"] - c0[i]["restarts"] + c1[i]["out_of_order"] - c0[i]["out_of_order"] for i in both)
+        dropped = sum(c1[i]["ring_dropped"] - c0[i]["ring_dropped"] + c1[i]["publish_dropped"] - c0[i]["publish_dropped"] for i in both)
         stepped = ph.get("offset_max", 0) > 3000 and ph.get("offset_min", 0) < -3000
         check(stepped, "clock step: the daemon's CLOCK_REALTIME stepped +1 h and -1 h (send times seen)",
               f"send time - real time from {ph.get('offset_min', 0):.0f} s to {ph.get('offset_max', 0):.0f} s")
-        check(moved == 0 and ph.get("max_gap", 1) < 0.05,
-              "clock step: nothing on the monotonic clock moved (no restart, no out-of-order, sample times continuous)",
-              f"restarts + out-of-order {moved}, largest sample-time step {ph.get('max_gap', 0) * 1000:.1f} ms")
+        # A window restarts at a step of more than 0.25 s in sample time, which a jump of the
+        # synthetic drivers' monotonic clock would be. Poses the daemon dropped (counted, when
+        # starved) also leave a step at the receiver, so that step is judged only without drops.
+        gap = ph.get("max_gap", 1)
+        check(len(both) == len(SYNTHETIC) and moved == 0 and (gap < 0.05 or dropped > 0),
+              "clock step: nothing on the monotonic clock moved (no window restart, no out-of-order sample)",
+              f"restarts + out-of-order {moved}; largest sample-time step at the receiver {gap * 1000:.1f} ms "
+              f"with {dropped} poses dropped (counted) meanwhile")
         self.leave()
 
     def fault_starvation(self):
