@@ -141,6 +141,7 @@ class Service {
 
     std::uint64_t watchdog_usec = 0;
     const bool watchdog = ::sd_watchdog_enabled(0, &watchdog_usec) > 0 && watchdog_usec > 0;
+    watchdog_ = watchdog;
     auto tick = std::chrono::milliseconds(1000);
     if (watchdog) tick = std::min(tick, std::chrono::milliseconds(std::max<std::uint64_t>(10, watchdog_usec / 4000)));
     std::uint64_t heartbeat_at_poke = pipeline_->engine_heartbeat();
@@ -355,6 +356,10 @@ class Service {
     }
     for (const std::string& w : next->warnings()) spdlog::warn("{}", w);
     pipeline_->stop(carry);
+    // The old engine drained everything it held, so it was alive: say so, for a reload that takes
+    // seconds on a loaded machine (the main thread does not tick meanwhile) must not look like a
+    // hang to systemd's watchdog.
+    if (watchdog_) notify("WATCHDOG=1");
     log_counters(*pipeline_, {}, 0.0);
     if (carry) next->adopt_recorder(pipeline_->release_recorder());
     if (keep_session && session == session_) next->continue_sequences(pipeline_->next_sequences());
@@ -380,6 +385,7 @@ class Service {
   Clock::time_point last_status_, last_log_;
   std::vector<StreamStats> last_status_stats_, last_log_stats_;
   int recorder_errno_ = 0;  // as last logged
+  bool watchdog_ = false;   // systemd's watchdog is on (WATCHDOG_USEC)
 };
 
 }  // namespace
