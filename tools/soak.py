@@ -842,8 +842,10 @@ class Soak:
             growth = points[-1][0] - early
             fds = [p_[1] for p_ in points]
             extra = sorted(set(points[-1][2]) - set(points[0][2])) if points[-1][1] != points[0][1] else []
-            # A phase may end while a device is being reopened: a transient descriptor is no leak.
-            check(fds[-1] == fds[0], "leaks: open descriptors flat after warm-up (the same at the last phase end as at the first)",
+            # A phase may end while a device is being reopened or a client served: a transient
+            # descriptor, one up or down, is no leak; a leak keeps the last phase ends above the first.
+            first_third = fds[:max(1, len(fds) // 3)]
+            check(min(fds[-3:]) <= max(first_third), "leaks: open descriptors flat after warm-up (the last phase ends not above the first third's)",
                   f"{fds}" + (f"; new: {extra}" if extra else ""))
             detail = (f"first {points[0][0]} KiB, largest in the first third {early} KiB, last {points[-1][0]} KiB "
                       f"({growth:+d} KiB; {len(points)} phase ends, range {min(p_[0] for p_ in points)}..{max(p_[0] for p_ in points)} KiB)")
