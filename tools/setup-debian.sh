@@ -33,6 +33,7 @@ packages=(
 # encodings, a Fast DDS reader (fastddsgen generates its type) the dds one.
 if [[ "${1:-}" == "--tests" ]]; then
   packages+=(liblo-tools libfastrtps-dev fastddsgen)
+  packages+=(libfaketime)  # the soak steps the daemon's CLOCK_REALTIME, not the host's (tools/soak.sh)
 fi
 # The hw tests' VM (tests/hw/vm/): Debian's own kernel under qemu, gpio-sim built against its
 # headers, and the tests' independent peers. Only amd64 boots that kernel.

@@ -456,11 +456,19 @@ void Pipeline::recorder_loop() {
           s.counters.record_paused.fetch_add(1, std::memory_order_relaxed);
           continue;
         }
-        if (writer_) writer_->append(unpack(r));
+        // A sample the writer refuses (its buffer full while the disk refuses writes) is lost:
+        // counted as a recorder drop, never as recorded.
+        if (writer_ && !writer_->append(unpack(r))) {
+          s.counters.record_refused.fetch_add(1, std::memory_order_relaxed);
+          continue;
+        }
         s.counters.recorded.fetch_add(1, std::memory_order_relaxed);
       }
     }
-    if (writer_) writer_->maybe_flush(std::chrono::duration<double>(clock::now() - t0).count());
+    if (writer_) {
+      writer_->maybe_flush(std::chrono::duration<double>(clock::now() - t0).count());
+      recorder_errno_.store(writer_->failing() ? writer_->stats().last_errno : 0, std::memory_order_relaxed);
+    }
     if (stopping) {
       if (writer_) writer_->flush();
       return;
@@ -492,7 +500,8 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.published = get(s.counters.published);
     st.send_failures = get(s.counters.send_failures);
     st.recorded = get(s.counters.recorded);
-    st.record_dropped = (s.record_ring ? s.record_ring->dropped() : 0) + get(s.counters.record_paused);
+    st.record_dropped =
+        (s.record_ring ? s.record_ring->dropped() : 0) + get(s.counters.record_paused) + get(s.counters.record_refused);
     st.latency = s.counters.latency.snapshot();
     st.device = s.driver->health();
     if (s.gpio.data_ready) st.data_ready = s.gpio.data_ready->counters();

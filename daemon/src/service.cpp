@@ -16,6 +16,7 @@
 #include <cinttypes>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <system_error>
@@ -140,6 +141,7 @@ class Service {
 
     std::uint64_t watchdog_usec = 0;
     const bool watchdog = ::sd_watchdog_enabled(0, &watchdog_usec) > 0 && watchdog_usec > 0;
+    watchdog_ = watchdog;
     auto tick = std::chrono::milliseconds(1000);
     if (watchdog) tick = std::min(tick, std::chrono::milliseconds(std::max<std::uint64_t>(10, watchdog_usec / 4000)));
     std::uint64_t heartbeat_at_poke = pipeline_->engine_heartbeat();
@@ -180,6 +182,7 @@ class Service {
       if (watchdog && hb != heartbeat_at_poke) notify("WATCHDOG=1");
       heartbeat_at_poke = hb;
       pipeline_->poke_engine();
+      log_recorder_change();
 
       const auto now = Clock::now();
       if (now - last_status_ >= std::chrono::seconds(1)) {
@@ -204,6 +207,21 @@ class Service {
 
  private:
   static double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+  // One line when the recording stops being written (disk full, I/O error), one when it writes
+  // again: the recorder thread only sets the state, the main thread logs it.
+  void log_recorder_change() {
+    const int error = pipeline_->recorder_errno();
+    if (error == recorder_errno_) return;
+    const std::string path = pipeline_->config().recorder.path.string();
+    if (error != 0)
+      spdlog::error("recording {}: cannot write: {}; publishing continues, samples that no longer fit the "
+                    "recorder's buffer are counted as recorder drops until a write succeeds",
+                    path, std::strerror(error));
+    else
+      spdlog::info("recording {}: writing again", path);
+    recorder_errno_ = error;
+  }
 
   void mark_interval() {
     last_status_ = Clock::now();
@@ -338,6 +356,10 @@ class Service {
     }
     for (const std::string& w : next->warnings()) spdlog::warn("{}", w);
     pipeline_->stop(carry);
+    // The old engine drained everything it held, so it was alive: say so, for a reload that takes
+    // seconds on a loaded machine (the main thread does not tick meanwhile) must not look like a
+    // hang to systemd's watchdog.
+    if (watchdog_) notify("WATCHDOG=1");
     log_counters(*pipeline_, {}, 0.0);
     if (carry) next->adopt_recorder(pipeline_->release_recorder());
     if (keep_session && session == session_) next->continue_sequences(pipeline_->next_sequences());
@@ -362,6 +384,8 @@ class Service {
   std::unique_ptr<Pipeline> pipeline_;
   Clock::time_point last_status_, last_log_;
   std::vector<StreamStats> last_status_stats_, last_log_stats_;
+  int recorder_errno_ = 0;  // as last logged
+  bool watchdog_ = false;   // systemd's watchdog is on (WATCHDOG_USEC)
 };
 
 }  // namespace

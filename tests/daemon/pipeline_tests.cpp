@@ -5,8 +5,11 @@
 // order), that every emitted pose is published and arrives, and that each overflow policy keeps
 // the samples it promises to keep.
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -446,6 +449,42 @@ TEST(Pipeline, RawOnlySamplesAreCountedNotFairedAndRecordedWithTheirReadings) {
     EXPECT_EQ(o.accel, recorded[i].accel) << i;
     EXPECT_EQ(o.orientation.coeffs(), recorded[i].orientation.coeffs()) << i;
   }
+}
+
+// The recording volume refuses writes (here: RLIMIT_FSIZE, EFBIG; in the soak a full tmpfs,
+// ENOSPC) while a 20 kHz source runs: the pipeline reports the error for the main thread to log,
+// counts every sample the writer's full buffer refuses as a recorder drop (never as recorded),
+// and writes again once the limit is lifted. At the end every sample is recorded or counted as
+// dropped, and every recorded one is in the file.
+TEST(Pipeline, ARecordingThatCannotBeWrittenCountsItsDropsAndResumes) {
+  ScratchDir dir;
+  const std::string text = "[[stream]]\nid = 1\nname = \"fast\"\n"
+                           "driver = { type = \"synthetic\", rate_hz = 20000.0, duration = 1.0 }\n\n"
+                           "[recorder]\npath = \"" + (dir / "out.pflog").string() +
+                           "\"\nsync = false\nflush_interval = 0.05\n";
+  const DaemonConfig config = parse_config(text, "/virtual/full.toml");
+  rlimit original{};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &original), 0);
+  const auto previous_handler = ::signal(SIGXFSZ, SIG_IGN);  // EFBIG instead of the signal
+  rlimit small = original;
+  small.rlim_cur = 64 * 1024;  // the header and a few hundred records
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  Pipeline pipeline(config, kSession, {}, false, {});
+  pipeline.start();
+  const bool failed = wait_until([&] { return pipeline.recorder_errno() == EFBIG && pipeline.stats().at(0).record_dropped > 0; }, 10s);
+  const StreamStats while_failing = pipeline.stats().at(0);
+  ::setrlimit(RLIMIT_FSIZE, &original);
+  ::signal(SIGXFSZ, previous_handler);
+  ASSERT_TRUE(failed) << "errno " << pipeline.recorder_errno() << ", recorder drops " << while_failing.record_dropped;
+  EXPECT_TRUE(wait_until([&] { return pipeline.recorder_errno() == 0; }, 10s)) << "the recording did not resume";
+  EXPECT_TRUE(wait_until([&] { return pipeline.sources_ended(); }, 30s));
+  pipeline.stop();
+  const StreamStats s = pipeline.stats().at(0);
+  EXPECT_GT(s.recorded, while_failing.recorded) << "nothing recorded after the limit was lifted";
+  EXPECT_EQ(s.received, s.recorded + s.record_dropped);
+  const formats::SampleLogContents out = formats::read_sample_log(dir / "out.pflog");
+  EXPECT_TRUE(out.stats.problems.empty()) << out.stats.problems.front().message;
+  EXPECT_EQ(out.samples.size(), s.recorded);
 }
 
 // A raw IMU stream with [stream.fusion]: 20 s at 100 Hz of gyroscope, accelerometer and

@@ -73,6 +73,9 @@ class Pipeline {
   // drops) instead of writing them, or writes again. Only with a [recorder]; true at start.
   void set_recording(bool on) { recording_.store(on, std::memory_order_relaxed); }
   bool recording() const { return config_.recorder.enabled && recording_.load(std::memory_order_relaxed); }
+  // 0 while the recording's writes succeed; the errno of the failure (ENOSPC, EIO, ...) while
+  // they fail. The main thread logs the changes (the recorder thread does not log).
+  int recorder_errno() const { return recorder_errno_.load(std::memory_order_relaxed); }
   // Accepted damage in replay sources etc., to be logged once by the caller.
   const std::vector<std::string>& warnings() const { return warnings_; }
   // The recording's header (stream table) this pipeline writes or would write.
@@ -113,6 +116,7 @@ class Pipeline {
   std::atomic<bool> publisher_stop_{false};
   std::atomic<bool> recorder_stop_{false};
   std::atomic<bool> recording_{true};
+  std::atomic<int> recorder_errno_{0};
   std::atomic<int> drivers_running_{0};
   std::thread engine_thread_, publisher_thread_, recorder_thread_;
   std::vector<std::jthread> driver_threads_;

@@ -33,6 +33,7 @@ struct StreamCounters {
   std::atomic<std::uint64_t> send_failures{0};    // failed sends (one per destination)
   std::atomic<std::uint64_t> recorded{0};         // handed to the recorder's writer
   std::atomic<std::uint64_t> record_paused{0};     // discarded while `posefair ctl record stop` held
+  std::atomic<std::uint64_t> record_refused{0};    // refused by the writer: its buffer full while writes fail (disk full)
   LatencyHistogram latency;                       // hand-over → last datagram of the pose sent
   // The engine's state (FairingWindow::state()): the rate and window it settled on, and what
   // its adaptation measured and chose. Written by the engine thread after each batch.

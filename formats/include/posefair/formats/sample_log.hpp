@@ -194,6 +194,8 @@ class SampleLogWriter {
   bool close();
 
   const SampleLogWriterStats& stats() const { return stats_; }
+  // The latest flush failed (e.g. ENOSPC; stats().last_errno says why) and none succeeded since.
+  bool failing() const { return failing_; }
   std::size_t buffered_bytes() const { return used_; }
   // The file being written now (its name changes with rotation).
   std::string_view current_path() const { return current_path_; }
