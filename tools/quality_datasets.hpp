@@ -67,4 +67,9 @@ struct QualityDataset {
 // all, every file and where it comes from.
 std::vector<QualityDataset> load_quality_datasets(const std::filesystem::path& data_dir, bool quick, std::ostream& notes);
 
+// One BROAD trial: the optical orientation (dropouts left out), the gyroscope at the same rows,
+// scored in the movement phases (use), and the optical stream's measured shift to the gyroscope.
+// Throws std::runtime_error naming the file and line of anything malformed.
+QualitySequence broad_sequence(const std::filesystem::path& path, const std::string& name);
+
 }  // namespace posefair::tools
