@@ -2,58 +2,31 @@
 // engine removes jitter without lag, estimates the gyro's bias and its time offset, and leaves
 // streams without a gyro exactly as they were.
 #include <cmath>
-#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "engine_test_support.hpp"
+#include "../support/gyro_tracker_motion.hpp"
 #include "posefair/core/fairing_window.hpp"
 
 namespace posefair {
 namespace {
 
-constexpr double kRate = 200.0;
 constexpr double kDeg = M_PI / 180.0;
 
-// Body angular velocity of a lively motion (rad/s): several hundred °/s at times.
-Vec3 body_rate(double t) {
-  return {4.0 * std::sin(2.0 * M_PI * 0.7 * t), 3.0 * std::cos(2.0 * M_PI * 0.45 * t + 0.3), 2.5 * std::sin(2.0 * M_PI * 1.3 * t + 1.0)};
-}
+using posefair::testing::GyroTrackerSpec;
+using GyroStream = posefair::testing::GyroTrackerStream;
 
-struct GyroStream {
-  std::vector<Quat> truth;
-  std::vector<Sample> samples;
-};
-
-// seconds of motion at kRate: the orientation integrated finely from body_rate, measured with
-// white jitter of jitter_deg RMS angle; each sample's gyro reads the rate at t − offset (the
-// reading stamped t + offset measured the motion at t), plus bias, in a frame rotated by
-// mounting⁻¹ from the body.
 GyroStream make_stream(double seconds, double jitter_deg, const Vec3& bias = Vec3::Zero(), double offset = 0.0,
-                       const Quat& mounting = Quat::Identity(), std::uint64_t seed = 1) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> n(0.0, jitter_deg * kDeg / std::sqrt(3.0));
-  GyroStream g;
-  Quat q = Quat::Identity();
-  const int substeps = 20;
-  const auto count = static_cast<std::size_t>(seconds * kRate);
-  for (std::size_t i = 0; i < count; ++i) {
-    const double t = static_cast<double>(i) / kRate;
-    g.truth.push_back(q);
-    Sample s;
-    s.sequence = i;
-    s.time = t;
-    s.orientation = (q * so3::from_rotation_vector(Vec3(n(rng), n(rng), n(rng)))).normalized();
-    s.gyro = mounting.conjugate() * body_rate(t - offset) + bias;
-    s.flags = kHasGyro;
-    g.samples.push_back(s);
-    for (int k = 0; k < substeps; ++k) {
-      const double h = 1.0 / (kRate * substeps);
-      q = (q * so3::from_rotation_vector(body_rate(t + (k + 0.5) * h) * h)).normalized();
-    }
-  }
-  return g;
+                       const Quat& mounting = Quat::Identity()) {
+  GyroTrackerSpec spec;
+  spec.seconds = seconds;
+  spec.jitter_deg = jitter_deg;
+  spec.bias = bias;
+  spec.offset = offset;
+  spec.mounting = mounting;
+  return posefair::testing::make_gyro_tracker_stream(spec);
 }
 
 std::vector<Sample> without_gyro(std::vector<Sample> s) {
@@ -80,7 +53,7 @@ double best_fairing_alone_deg(const GyroStream& g) {
   double best = 1e300;
   for (double fc : {1.0, 2.0, 4.0, 8.0, 16.0, 32.0}) {
     WindowConfig c;
-    c.rate_hz = kRate;
+    c.rate_hz = 200.0;
     c.cutoff_hz = fc;
     FairingWindow w(c);
     best = std::min(best, rms_error_deg(posefair::testing::run(w, plain), g.truth));
