@@ -50,6 +50,12 @@ void GyroAiding::update(std::span<const Sample> samples, std::span<const Vec3> z
 
 void GyroAiding::observe(const Vec3& r, const Vec3& s, double dt) {
   ++intervals_;
+  elapsed_ += dt;
+  if (settings_.estimate_time_offset) observe_offset(r, s, dt);
+  // The bias once the offset is known (or the motion has not told it for offset_time_s):
+  // before, the offset's error (δ·Δω/2, following the motion) would pass into the bias's
+  // line, and the bias's error back into the offset.
+  if (settings_.estimate_time_offset && !offset_estimated_ && elapsed_ < settings_.offset_time_s) return;
   // Bias: u = r − R b̂ dt/2 = ζ − R ω_gyro dt/2 is −R b dt/2 plus jitter that telescopes in
   // its running sum θ, so b is −2Rᵀ times the slope of θ over time: a least-squares line with
   // exponential forgetting, kept relative to the newest time (shift the sums by dt, add θ at 0).
@@ -63,7 +69,9 @@ void GyroAiding::observe(const Vec3& r, const Vec3& s, double dt) {
   span_ += dt;
   const double det = s0_ * s2_ - s1_ * s1_;
   if (span_ >= kBiasMinimumSpan && det > 0.0) bias_ = -2.0 * (settings_.mounting.conjugate() * ((s0_ * y1_ - s1_ * y0_) / det));
-  if (!settings_.estimate_time_offset) return;
+}
+
+void GyroAiding::observe_offset(const Vec3& r, const Vec3& s, double dt) {
   // Offset: r(δ) ≈ r(δ̂) − (δ − δ̂)·s is zero on average at the true δ, so δ is the
   // least-squares solution of (r(δ̂) + δ̂·s) = δ·s over the intervals seen.
   const double forget = std::exp(-dt / settings_.offset_time_s);

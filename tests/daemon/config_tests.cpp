@@ -1319,7 +1319,7 @@ gyro_time_offset = 0.2
 id = 1
 name = "a"
 driver = { type = "synthetic", rate_hz = 100 }
-)", "engine.gyro_time_offset: out of range: must be in (-0.05, 0.05), got 0.2", 2},
+)", "engine.gyro_time_offset: out of range: must be in [-0.05, 0.05], got 0.2", 2},
     {"gyro_time_offset not a number", R"([engine]
 gyro_time_offset = "4ms"
 [[stream]]

@@ -99,6 +99,18 @@ TEST(GyroAidedFairing, FindsTheTimeOffsetBetweenOrientationAndGyro) {
   EXPECT_LT(aided, 0.8 * unestimated) << "estimated " << aided << "°, not estimated " << unestimated << "°";
 }
 
+TEST(GyroAidedFairing, EstimatesBiasAndTimeOffsetTogether) {
+  // Each alone would be found; together the offset's error follows the motion into the
+  // bias's line unless the bias waits for the offset.
+  const Vec3 bias(0.02, -0.03, 0.01);
+  const GyroStream g = make_stream(20.0, 1.0, bias, 0.005);
+  FairingWindow w{WindowConfig{}};
+  posefair::testing::run(w, g.samples, false);
+  const GyroAidingState s = w.state().gyro;
+  EXPECT_NEAR(s.time_offset_s, 0.005, 0.0005);
+  EXPECT_LT((s.bias - bias).norm(), 0.005) << s.bias.transpose();
+}
+
 TEST(GyroAidedFairing, AMountedGyroIsRotatedIntoTheBodyFrame) {
   const Quat mounting = so3::from_rotation_vector(Vec3(0.4, -1.1, 2.0));
   const GyroStream g = make_stream(10.0, 1.0, Vec3::Zero(), 0.0, mounting);

@@ -20,7 +20,8 @@
 //     r_j(δ) = r_j(δ̂) − (δ − δ̂) s_j with s_j = ∂g_j/∂δ = (ω(t_{j+1}+δ̂) − ω(t_j+δ̂))/2 (the
 //     angular acceleration's work over the interval); a recursive least-squares fit of δ
 //     relinearised at every interval, with forgetting time offset_time_s, applied once its
-//     standard error is below kOffsetResolution.
+//     standard error is below kOffsetResolution. The bias is estimated from then on, or after
+//     offset_time_s without one (before, each estimate's error would pass into the other).
 // No allocation: everything works on the window's own arrays.
 #include <cstdint>
 #include <span>
@@ -72,6 +73,7 @@ class GyroAiding {
   // held beyond the window's ends.
   Vec3 rate_at(std::span<const Sample> samples, double t) const;
   void observe(const Vec3& residual, const Vec3& sensitivity, double dt);
+  void observe_offset(const Vec3& residual, const Vec3& sensitivity, double dt);
 
   GyroAidingSettings settings_;
   Vec3 bias_ = Vec3::Zero();
@@ -88,6 +90,7 @@ class GyroAiding {
   Vec3 last_s_ = Vec3::Zero();
   double residual_var_ = 0.0;       // mean square of the residual per component
   std::uint64_t intervals_ = 0;
+  double elapsed_ = 0.0;  // seconds of intervals observed
 };
 
 }  // namespace posefair
