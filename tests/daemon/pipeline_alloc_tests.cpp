@@ -34,6 +34,7 @@
 #include "posefair/formats/sample_log.hpp"
 
 #include "../support/counting_allocator.hpp"
+#include "../support/gyro_tracker_motion.hpp"
 #include "../support/test_files.hpp"
 #include "../support/udp_collector.hpp"
 
@@ -193,6 +194,34 @@ TEST_F(PipelineAllocation, RawOnlySamplesAllocateNothingOnTheRealtimeThreads) {
   EXPECT_EQ(run.stats.received, 1000u);
   EXPECT_EQ(run.stats.raw_unfused, 500u);
   EXPECT_EQ(run.stats.published, 500u);
+}
+
+// Orientations that carry a gyroscope reading: gyro-aided fairing, with its bias and time
+// offset estimates, on the engine thread, allocates nothing either.
+TEST_F(PipelineAllocation, GyroAidedFairingAllocatesNothingOnTheRealtimeThreads) {
+  posefair::testing::ScratchDir dir;
+  posefair::testing::GyroTrackerSpec spec;
+  spec.seconds = 5.0;
+  spec.offset = 0.004;
+  spec.bias = Vec3(0.01, 0.0, -0.02);
+  {
+    formats::SampleLogHeader h;
+    h.streams = {{1, "tracker", "test"}};
+    formats::SampleLogWriterOptions o;
+    o.sync = false;
+    formats::SampleLogWriter w(dir / "gyro.pflog", h, o);
+    for (const Sample& s : posefair::testing::make_gyro_tracker_stream(spec).samples) w.append(s);
+  }
+  const PipelineRun run =
+      run_pipeline("type = \"replay\"\npath = \"" + (dir / "gyro.pflog").string() + "\"\ntiming = \"fast\"\n", "linear", "binary");
+  SCOPED_TRACE(describe(run));
+  EXPECT_TRUE(run.ended);
+  ASSERT_EQ(run.threads, 2);
+  for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
+  EXPECT_EQ(run.stats.received, 1000u);
+  EXPECT_EQ(run.stats.published, 1000u);
+  EXPECT_TRUE(run.stats.engine.gyro.active);
+  EXPECT_GT(run.stats.engine.gyro.intervals, 900u);
 }
 
 TEST_F(PipelineAllocation, GaussNewtonOnASyntheticStreamAllocatesNothingOnTheRealtimeThreads) {
