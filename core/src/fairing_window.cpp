@@ -501,7 +501,9 @@ void FairingWindow::slide(int count) {
 }
 
 bool FairingWindow::gyro_aided(const Sample& s) const {
-  return config_.gyro.enabled && s.has_gyro() && config_.solver == WindowSolver::Linear && config_.horizon_s == 0.0;
+  // A non-finite reading is no reading: it would poison the window and the estimates.
+  return config_.gyro.enabled && s.has_gyro() && s.gyro.allFinite() && config_.solver == WindowSolver::Linear &&
+         config_.horizon_s == 0.0;
 }
 
 void FairingWindow::append(const Sample& s) {

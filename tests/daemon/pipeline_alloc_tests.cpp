@@ -115,6 +115,17 @@ PipelineRun run_pipeline(const std::string& driver, const std::string& solver, c
   return run;
 }
 
+// Writes samples (stream 1) to a sample log at path; the replay driver's table body for it.
+std::string replay_of(const std::filesystem::path& path, const std::vector<Sample>& samples) {
+  formats::SampleLogHeader h;
+  h.streams = {{1, "imu", "test"}};
+  formats::SampleLogWriterOptions o;
+  o.sync = false;
+  formats::SampleLogWriter w(path, h, o);
+  for (const Sample& s : samples) w.append(s);
+  return "type = \"replay\"\npath = \"" + path.string() + "\"\ntiming = \"fast\"\n";
+}
+
 std::string describe(const PipelineRun& run) {
   std::ostringstream s;
   s << "slots:";
@@ -168,25 +179,17 @@ TEST_F(PipelineAllocation, ReplayToABinaryOutputAllocatesNothingOnTheRealtimeThr
 // the engine's raw-only path, which counts and skips, allocates nothing either.
 TEST_F(PipelineAllocation, RawOnlySamplesAllocateNothingOnTheRealtimeThreads) {
   testing::ScratchDir dir;
-  {
-    formats::SampleLogHeader h;
-    h.streams = {{1, "imu", "test"}};
-    formats::SampleLogWriterOptions o;
-    o.sync = false;
-    formats::SampleLogWriter w(dir / "raw.pflog", h, o);
-    for (std::uint64_t i = 0; i < 1000; ++i) {
-      Sample s;
-      s.stream_id = 1;
-      s.sequence = i;
-      s.time = 0.005 * static_cast<double>(i);
-      s.flags = (i % 2 ? kNoOrientation : 0u) | kHasGyro | kHasAccel;
-      s.gyro = Vec3(0, 0, 0.5);
-      s.accel = Vec3(0, 0, 9.81);
-      w.append(s);
-    }
+  std::vector<Sample> samples(1000);
+  for (std::uint64_t i = 0; i < samples.size(); ++i) {
+    Sample& s = samples[i];
+    s.stream_id = 1;
+    s.sequence = i;
+    s.time = 0.005 * static_cast<double>(i);
+    s.flags = (i % 2 ? kNoOrientation : 0u) | kHasGyro | kHasAccel;
+    s.gyro = Vec3(0, 0, 0.5);
+    s.accel = Vec3(0, 0, 9.81);
   }
-  const PipelineRun run =
-      run_pipeline("type = \"replay\"\npath = \"" + (dir / "raw.pflog").string() + "\"\ntiming = \"fast\"\n", "linear", "binary");
+  const PipelineRun run = run_pipeline(replay_of(dir / "raw.pflog", samples), "linear", "binary");
   SCOPED_TRACE(describe(run));
   EXPECT_TRUE(run.ended);
   ASSERT_EQ(run.threads, 2);
@@ -204,16 +207,8 @@ TEST_F(PipelineAllocation, GyroAidedFairingAllocatesNothingOnTheRealtimeThreads)
   spec.seconds = 5.0;
   spec.offset = 0.004;
   spec.bias = Vec3(0.01, 0.0, -0.02);
-  {
-    formats::SampleLogHeader h;
-    h.streams = {{1, "tracker", "test"}};
-    formats::SampleLogWriterOptions o;
-    o.sync = false;
-    formats::SampleLogWriter w(dir / "gyro.pflog", h, o);
-    for (const Sample& s : posefair::testing::make_gyro_tracker_stream(spec).samples) w.append(s);
-  }
-  const PipelineRun run =
-      run_pipeline("type = \"replay\"\npath = \"" + (dir / "gyro.pflog").string() + "\"\ntiming = \"fast\"\n", "linear", "binary");
+  const PipelineRun run = run_pipeline(
+      replay_of(dir / "gyro.pflog", posefair::testing::make_gyro_tracker_stream(spec).samples), "linear", "binary");
   SCOPED_TRACE(describe(run));
   EXPECT_TRUE(run.ended);
   ASSERT_EQ(run.threads, 2);

@@ -141,12 +141,15 @@ TEST(GyroAidedFairing, StreamsWithoutAGyroOrWithAidingOffAreUnchanged) {
 TEST(GyroAidedFairing, AGyroThatComesAndGoesRestartsTheWindow) {
   GyroStream g = make_stream(4.0, 1.0);
   for (std::size_t i = 300; i < 400; ++i) g.samples[i].flags &= ~static_cast<std::uint32_t>(kHasGyro);
+  g.samples[400].gyro.x() = std::nan("");  // a non-finite reading counts as none (the window restarts at 401)
   FairingWindow w{WindowConfig{}};
   const std::vector<FairedPose> out = posefair::testing::run(w, g.samples);
   EXPECT_EQ(out.size(), g.samples.size());
   EXPECT_EQ(w.counters().restarts, 2u);
   EXPECT_TRUE(w.state().gyro.active);
   EXPECT_LT(rms_error_deg(out, g.truth), 1.0);
+  for (const FairedPose& p : out) ASSERT_TRUE(p.orientation.coeffs().allFinite()) << p.sequence;
+  EXPECT_TRUE(w.state().gyro.bias.allFinite());
 }
 
 }  // namespace
