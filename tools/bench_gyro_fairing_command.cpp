@@ -69,9 +69,7 @@ double error_deg(const QualitySequence& clean, const std::vector<Quat>& pose) {
   return count ? std::sqrt(sum / static_cast<double>(count)) * 180.0 / M_PI : 0.0;
 }
 
-std::string trial_number(const std::string& trial) { return trial.substr(0, trial.find('_')); }
-
-struct Row {
+struct TrialScores {
   double raw = 0.0, fairing_default = 0.0, gyro = 0.0, gyro_no_offset = 0.0;
   std::vector<double> fairing;   // per cutoff
   std::vector<double> one_euro;  // per One Euro candidate
@@ -115,10 +113,10 @@ int bench_gyro_fairing(const std::string& data, const std::string& out_dir, int 
   bool all_met = true;
   for (const double jitter : {0.5, 1.0}) {
     const double goal = jitter < 0.75 ? 0.75 : 0.6;
-    std::vector<Row> rows(d.sequences.size());
+    std::vector<TrialScores> rows(d.sequences.size());
     for (std::size_t t = 0; t < d.sequences.size(); ++t) {
       const QualitySequence& clean = d.sequences[t];
-      Row& r = rows[t];
+      TrialScores& r = rows[t];
       r.fairing.assign(std::size(kCutoffs), 0.0);
       r.one_euro.assign(euro.size(), 0.0);
       for (int s = 0; s < seeds; ++s) {
@@ -150,7 +148,7 @@ int bench_gyro_fairing(const std::string& data, const std::string& out_dir, int 
                 "|---|---|---|---|---|---|---|---|---|---|\n");
     std::vector<double> sums(6, 0.0);
     for (std::size_t t = 0; t < rows.size(); ++t) {
-      const Row& r = rows[t];
+      const TrialScores& r = rows[t];
       const auto best = static_cast<std::size_t>(std::min_element(r.fairing.begin(), r.fairing.end()) - r.fairing.begin());
       // One Euro: the candidate with the lowest mean error relative to raw on the other trials.
       std::vector<std::size_t> candidates(euro.size()), train;
@@ -163,7 +161,7 @@ int bench_gyro_fairing(const std::string& data, const std::string& out_dir, int 
       const double euro_err = pick ? r.one_euro[*pick] : std::nan("");
       const double ratio = r.gyro / r.fairing[best];
       all_met = all_met && ratio <= goal;
-      const std::string name = trial_number(d.sequences[t].name);
+      const std::string name = broad_trial_number(d.sequences[t].name);
       std::printf("| %s | %.3f | %.3f (%g Hz) | %.3f | %.3f (%s) | %.3f | %.3f | %.2f%s | %.1f | %.2f |\n", name.c_str(), r.raw,
                   r.fairing[best], kCutoffs[best], r.fairing_default, euro_err, pick ? euro[*pick].config.c_str() : "-", r.gyro,
                   r.gyro_no_offset, ratio, ratio <= goal ? "" : " **missed**", r.offset_ms, r.bias.norm() * 180.0 / M_PI);

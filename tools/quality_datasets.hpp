@@ -72,4 +72,7 @@ std::vector<QualityDataset> load_quality_datasets(const std::filesystem::path& d
 // Throws std::runtime_error naming the file and line of anything malformed.
 QualitySequence broad_sequence(const std::filesystem::path& path, const std::string& name);
 
+// A BROAD trial's number, "07" of "07_undisturbed_fast_rotation_B", for tables.
+inline std::string broad_trial_number(const std::string& trial) { return trial.substr(0, trial.find('_')); }
+
 }  // namespace posefair::tools
