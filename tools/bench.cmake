@@ -1,8 +1,9 @@
-# `posefair bench quality`, `posefair bench latency` and `posefair bench fusion` (docs/benchmarks.md).
+# `posefair bench quality`, `posefair bench latency`, `posefair bench fusion` and `posefair bench gyro-fairing` (docs/benchmarks.md).
 target_sources(posefair_cli PRIVATE
   ${CMAKE_CURRENT_SOURCE_DIR}/bench_quality_command.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/bench_latency_command.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/bench_fusion_command.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/bench_gyro_fairing_command.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/quality_datasets.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/quality_scoring.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/quality_configurations.cpp

@@ -19,6 +19,7 @@
 
 #include "benchmark_data.hpp"
 #include "fusion_run.hpp"
+#include "quality_datasets.hpp"
 #include "posefair/core/error.hpp"
 #include "posefair/core/orientation_error.hpp"
 #include "posefair/formats/pose_file.hpp"
@@ -110,8 +111,6 @@ double madgwick_tagp_beta(const std::vector<FusionTrial>& trials, bool six_d) {
   return best_beta;
 }
 
-std::string trial_number(const std::string& trial) { return trial.substr(0, trial.find('_')); }
-
 int bench_fusion(const std::string& data, const std::string& out_dir, bool grid) {
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<FusionTrial> trials;
@@ -143,7 +142,7 @@ int bench_fusion(const std::string& data, const std::string& out_dir, bool grid)
   for (std::size_t i = 0; i < trials.size(); ++i)
     for (std::size_t j = 0; j < methods.size(); ++j) {
       const auto published = kPublishedMadgwick.find(trials[i].name);
-      csv << trial_number(trials[i].name) << ",\"" << methods[j].label << "\"," << (methods[j].six_d ? "6D" : "9D") << ','
+      csv << broad_trial_number(trials[i].name) << ",\"" << methods[j].label << "\"," << (methods[j].six_d ? "6D" : "9D") << ','
           << results[i][j].total_deg << ',' << results[i][j].heading_deg << ',' << results[i][j].inclination_deg << ','
           << (published != kPublishedMadgwick.end() ? std::to_string(published->second) : "") << "\n";
     }
@@ -161,7 +160,7 @@ int bench_fusion(const std::string& data, const std::string& out_dir, bool grid)
     double published_sum = 0.0;
     std::size_t published_n = 0;
     for (std::size_t i = 0; i < trials.size(); ++i) {
-      std::printf("| %s |", trial_number(trials[i].name).c_str());
+      std::printf("| %s |", broad_trial_number(trials[i].name).c_str());
       if (!six_d) {
         const auto p = kPublishedMadgwick.find(trials[i].name);
         if (p != kPublishedMadgwick.end()) {

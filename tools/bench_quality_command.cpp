@@ -2,6 +2,7 @@
 
 #include "bench_command.hpp"
 #include "bench_fusion_command.hpp"
+#include "bench_gyro_fairing_command.hpp"
 #include "bench_latency_command.hpp"
 
 #include <algorithm>
@@ -543,6 +544,7 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   quality->callback([=, &exit_code] { exit_code = bench_quality(*data, *out, *quick); });
   add_bench_latency_command(*bench, exit_code);
   add_bench_fusion_command(*bench, exit_code);
+  add_bench_gyro_fairing_command(*bench, exit_code);
 }
 
 }  // namespace posefair::tools

@@ -151,9 +151,9 @@ QualitySequence tum(const std::filesystem::path& est_path, const std::filesystem
   return q;
 }
 
-// BROAD: optical orientation (with dropouts left out) against the gyroscope, scored in the
-// movement phases.
-QualitySequence broad(const std::filesystem::path& path, const std::string& name) {
+}  // namespace
+
+QualitySequence broad_sequence(const std::filesystem::path& path, const std::string& name) {
   std::ifstream f(path);
   if (!f) throw std::runtime_error(path.string() + ": cannot open");
   std::string line;
@@ -199,6 +199,8 @@ QualitySequence broad(const std::filesystem::path& path, const std::string& name
   q.gyro_shift = best_rate_shift(rates, q.input.time, q.gyro, q.use, -0.05, 0.05, 0.25 / q.rate_hz).shift;
   return q;
 }
+
+namespace {
 
 // A BVH joint (frame 0, the T-pose, left out) with bounded random rotations added.
 QualitySequence bvh(const std::filesystem::path& path, const std::string& joint, double noise, std::uint64_t seed,
@@ -361,7 +363,7 @@ std::vector<QualityDataset> load_quality_datasets(const std::filesystem::path& d
       const std::string f = std::string("broad/") + b.file + ".csv";
       if (!present(std::string("broad-") + b.file, {f})) continue;
       (b.train ? fold.train : fold.report).push_back(d.sequences.size());
-      d.sequences.push_back(broad(dir / f, b.file));
+      d.sequences.push_back(broad_sequence(dir / f, b.file));
     }
     d.folds.push_back(fold);
     add(std::move(d));

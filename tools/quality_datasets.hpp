@@ -67,4 +67,12 @@ struct QualityDataset {
 // all, every file and where it comes from.
 std::vector<QualityDataset> load_quality_datasets(const std::filesystem::path& data_dir, bool quick, std::ostream& notes);
 
+// One BROAD trial: the optical orientation (dropouts left out), the gyroscope at the same rows,
+// scored in the movement phases (use), and the optical stream's measured shift to the gyroscope.
+// Throws std::runtime_error naming the file and line of anything malformed.
+QualitySequence broad_sequence(const std::filesystem::path& path, const std::string& name);
+
+// A BROAD trial's number, "07" of "07_undisturbed_fast_rotation_B", for tables.
+inline std::string broad_trial_number(const std::string& trial) { return trial.substr(0, trial.find('_')); }
+
 }  // namespace posefair::tools

@@ -88,7 +88,8 @@ DeliveredStream delivered_as_sampled(const PoseSequence& input, std::vector<Quat
   return s;
 }
 
-DeliveredStream run_engine(const PoseSequence& input, const WindowConfig& config) {
+DeliveredStream run_engine(const PoseSequence& input, const WindowConfig& config, std::span<const Vec3> gyro,
+                           EngineState* final_state) {
   const auto t0 = std::chrono::steady_clock::now();
   FairingWindow window(config);
   std::vector<FairedPose> out(static_cast<std::size_t>(window.max_outputs_per_push()));
@@ -110,8 +111,13 @@ DeliveredStream run_engine(const PoseSequence& input, const WindowConfig& config
     sample.sequence = i;
     sample.time = input.time[i];
     sample.orientation = input.orientation[i];
+    if (!gyro.empty()) {
+      sample.gyro = gyro[i];
+      sample.flags |= kHasGyro;
+    }
     take(window.push(sample, out), input.time[i]);
   }
+  if (final_state != nullptr) *final_state = window.state();
   if (!input.time.empty()) take(window.flush(out), input.time.back());
   s.ns_per_sample = 1e9 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
                     static_cast<double>(std::max<std::size_t>(1, input.size()));

@@ -9,6 +9,7 @@
 // BROAD has no orientation truth: its smoothing error is the body rate from consecutive
 // outputs against the gyroscope (rad/s), at the optical stream's own shift to the gyroscope;
 // its prediction truth is the optical sample nearest t + h, carried to t + h by the gyroscope.
+#include <span>
 #include <vector>
 
 #include "posefair/core/fairing_window.hpp"
@@ -29,8 +30,10 @@ DeliveredStream delivered_as_sampled(const PoseSequence& input, std::vector<Quat
 
 // The real-time engine over a sequence, sample by sample as fair_causal and the daemon run it,
 // recording which push emitted each pose (the tail a flush emits is delivered at the last
-// sample's time).
-DeliveredStream run_engine(const PoseSequence& input, const WindowConfig& config);
+// sample's time). gyro: none, or one reading per sample (rad/s), which the samples then carry
+// (kHasGyro: gyro-aided fairing). final_state: the engine's state after the last push.
+DeliveredStream run_engine(const PoseSequence& input, const WindowConfig& config, std::span<const Vec3> gyro = {},
+                           EngineState* final_state = nullptr);
 
 // The largest rotation angle between run_engine's poses and fair_causal's for the same input and
 // configuration: the benchmark's rows must be what fair_causal gives.

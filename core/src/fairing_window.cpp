@@ -158,12 +158,15 @@ FairingWindow::FairingWindow(const WindowConfig& config)
       builder_(capacity_, config.order),
       fill_row_(make_emission_row(capacity_)),
       rot_(capacity_, config.order),
-      pos_(capacity_, config.order) {
+      pos_(capacity_, config.order),
+      gyro_(config.gyro),
+      aided_estimator_(capacity_, config.order) {
   const auto w = static_cast<std::size_t>(capacity_);
   samples_.resize(w);
   z_.resize(w);
   x_.resize(w);
   zeta_.resize(w);
+  residual_.resize(w);
   est_.resize(w);
   window_clamped_.assign(w, 0);
   c_.resize(w);
@@ -252,6 +255,11 @@ void FairingWindow::prepare(double rate_hz) {
       }
       rot_.estimator.configure(rate_hz, config_.adaptation);
       pos_.estimator.configure(rate_hz, config_.adaptation);
+      AdaptationSettings aided = config_.adaptation;
+      aided.motion_span_s = w_ / rate_hz;
+      aided.motion_time_s = std::max(aided.motion_time_s, aided.motion_span_s);
+      aided.motion_floor = false;
+      aided_estimator_.configure(rate_hz, aided);
     }
   }
   prepared_ = true;
@@ -260,13 +268,14 @@ void FairingWindow::prepare(double rate_hz) {
 
 void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
   if (!ch.adaptive || !prepared_) return;
-  ch.estimator.update(zeta, dt);
-  if (!ch.estimator.ready()) {
+  MotionNoiseEstimator& estimator = &ch == &rot_ && aided_ ? aided_estimator_ : ch.estimator;
+  estimator.update(zeta, dt);
+  if (!estimator.ready()) {
     ch.level = 0.0;
     ch.mu = 0.0;
     return;
   }
-  ch.level = best_level(levels_, level_count_, ch.estimator.noise_variance(), config_.adaptation.motion_margin * ch.estimator.motion_variance());
+  ch.level = best_level(levels_, level_count_, estimator.noise_variance(), config_.adaptation.motion_margin * estimator.motion_variance());
   // The μ a window still filling uses, and the one reported: geometric between the levels
   // (linear from the pass-through level 0).
   const int i = static_cast<int>(ch.level);
@@ -346,6 +355,7 @@ EngineState FairingWindow::state() const {
   s.rate_hz = rate_;
   s.window = w_;
   const double dt = rate_ > 0.0 ? 1.0 / rate_ : 0.0;
+  s.gyro = gyro_.state(aided_);
   for (const bool rotation : {true, false}) {
     const Channel& ch = rotation ? rot_ : pos_;
     ChannelAdaptation& out = rotation ? s.rotation : s.position;
@@ -355,8 +365,9 @@ EngineState FairingWindow::state() const {
     out.smoothing = ch.mu;
     out.cutoff_hz = cutoff_for_smoothing(ch.mu, rate_, config_.order);
     if (ch.adaptive) {
-      out.noise = unit * std::sqrt(3.0 * ch.estimator.noise_variance());
-      out.motion = dt > 0.0 ? unit * std::sqrt(3.0 * ch.estimator.motion_variance()) / std::pow(dt, config_.order) : 0.0;
+      const MotionNoiseEstimator& estimator = rotation && aided_ ? aided_estimator_ : ch.estimator;
+      out.noise = unit * std::sqrt(3.0 * estimator.noise_variance());
+      out.motion = dt > 0.0 ? unit * std::sqrt(3.0 * estimator.motion_variance()) / std::pow(dt, config_.order) : 0.0;
     }
   }
   return s;
@@ -364,10 +375,10 @@ EngineState FairingWindow::state() const {
 
 void FairingWindow::linear_emission_estimate(int k, double dt) {
   const auto d = static_cast<std::size_t>(std::max(0, n_ - 1));
-  adapt(rot_, std::span<const Vec3>(zeta_).first(d), dt);
+  adapt(rot_, std::span<const Vec3>(rotation_increments()).first(d), dt);
   if (positions_) adapt(pos_, std::span<const Vec3>(dzp_).first(d), dt);
   if (k < 0) return;
-  est_[static_cast<std::size_t>(k)] = linear_correction(rot_, zeta_, c_);
+  est_[static_cast<std::size_t>(k)] = linear_correction(rot_, rotation_increments(), c_);
   if (positions_) xp_[static_cast<std::size_t>(k)] = zp_[static_cast<std::size_t>(k)] + linear_correction(pos_, dzp_, cp_);
 }
 
@@ -375,7 +386,7 @@ std::size_t FairingWindow::memory_bytes() const {
   std::size_t bytes = sizeof(*this);
   bytes += samples_.capacity() * sizeof(Sample);
   bytes += (z_.capacity() + x_.capacity() + y_.capacity() + target_.capacity()) * sizeof(Quat);
-  bytes += (zeta_.capacity() + est_.capacity() + c_.capacity() + dzp_.capacity() + cp_.capacity()) * sizeof(Vec3);
+  bytes += (zeta_.capacity() + residual_.capacity() + est_.capacity() + c_.capacity() + dzp_.capacity() + cp_.capacity()) * sizeof(Vec3);
   bytes += (zp_.capacity() + xp_.capacity() + yp_.capacity() + e_.capacity() + u_.capacity() + w_scratch_.capacity() +
             rhs_.capacity()) * sizeof(Vec3);
   bytes += diag_.capacity() * sizeof(double) + window_clamped_.capacity();
@@ -385,7 +396,7 @@ std::size_t FairingWindow::memory_bytes() const {
   bytes += row_bytes(fill_row_) + row_bytes(rot_.fixed) + row_bytes(pos_.fixed);
   // The builder's band matrix and scratch, and the estimators' fit weights.
   bytes += static_cast<std::size_t>(capacity_) * (static_cast<std::size_t>(config_.order + 1) + 5) * sizeof(double) +
-           static_cast<std::size_t>(capacity_ + 1) * sizeof(Vec3) + 2 * static_cast<std::size_t>(capacity_) * sizeof(double);
+           static_cast<std::size_t>(capacity_ + 1) * sizeof(Vec3) + 3 * static_cast<std::size_t>(capacity_) * sizeof(double);
   for (const auto* set : {&factors_r_, &factors_t_}) {
     bytes += set->capacity() * sizeof(BandedCholesky);
     for (const BandedCholesky& f : *set) bytes += static_cast<std::size_t>(f.size() * (f.bandwidth() + 1)) * sizeof(double);
@@ -443,8 +454,8 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   const GateVerdict verdict = gate_.check(s);
   if (verdict != GateVerdict::Accept && verdict != GateVerdict::AcceptAfterGap) return 0;
   int count = 0;
-  // A gap, or a change between streams with and without positions, starts a new window.
-  if (n_ > 0 && (verdict == GateVerdict::AcceptAfterGap || s.has_position() != positions_)) {
+  // A gap, or a change between samples with and without positions or gyro, starts a new window.
+  if (n_ > 0 && (verdict == GateVerdict::AcceptAfterGap || s.has_position() != positions_ || gyro_aided(s) != aided_)) {
     count = emit_pending(out);
     ++counters_.restarts;
   }
@@ -472,6 +483,7 @@ void FairingWindow::slide(int count) {
   drop(z_);
   if (config_.solver == WindowSolver::Linear) {
     drop(zeta_);
+    drop(residual_);
     drop(c_);
     drop(dzp_);
     drop(cp_);
@@ -488,8 +500,17 @@ void FairingWindow::slide(int count) {
   n_ -= count;
 }
 
+bool FairingWindow::gyro_aided(const Sample& s) const {
+  // A non-finite reading is no reading: it would poison the window and the estimates.
+  return config_.gyro.enabled && s.has_gyro() && s.gyro.allFinite() && config_.solver == WindowSolver::Linear &&
+         config_.horizon_s == 0.0;
+}
+
 void FairingWindow::append(const Sample& s) {
-  if (n_ == 0) positions_ = s.has_position();
+  if (n_ == 0) {
+    positions_ = s.has_position();
+    aided_ = gyro_aided(s);
+  }
   if (n_ == w_) slide(1);
   const auto k = static_cast<std::size_t>(n_);
   samples_[k] = s;
@@ -508,6 +529,11 @@ void FairingWindow::append(const Sample& s) {
       if (n_ >= 1) dzp_[k - 1] = s.position - zp_[k - 1];
     }
     ++n_;
+    if (aided_ && n_ >= 2) {
+      const auto n = static_cast<std::size_t>(n_);
+      gyro_.update(std::span<const Sample>(samples_).first(n), std::span<const Vec3>(zeta_).first(n - 1),
+                   std::span<Vec3>(residual_).first(n - 1));
+    }
     return;
   }
   // Warm start: the previous window's estimates stay. The paper's sweeps have no data term, so
@@ -560,7 +586,7 @@ void FairingWindow::linear_window() {
   }
   EmissionTarget whole = target_spec_;
   whole.horizon = 0.0;
-  builder_.solve_window(n, rot_.mu, whole, zeta_, est_);
+  builder_.solve_window(n, rot_.mu, whole, rotation_increments(), est_);
   if (positions_) {
     builder_.solve_window(n, pos_.mu, whole, dzp_, e_);
     for (int i = 0; i < n; ++i) xp_[static_cast<std::size_t>(i)] = zp_[static_cast<std::size_t>(i)] + e_[static_cast<std::size_t>(i)];

@@ -99,7 +99,7 @@ void MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
   }
   if (motion_ready_) {
     const double fit_noise = noise_var_ * fit_noise_gain_;
-    motion_var_ = std::max(fit_noise, mean_square_ - fit_noise);
+    motion_var_ = std::max(settings_.motion_floor ? fit_noise : 0.0, mean_square_ - fit_noise);
   }
 }
 

@@ -137,7 +137,8 @@ constexpr std::string_view kLoggingKeys[] = {"level", "target", "status_interval
 constexpr std::string_view kEngineKeys[] = {
     "window",   "window_time", "max_window", "lag", "horizon", "order", "solver", "iterations", "smoothing", "smoothing_r",
     "smoothing_t", "cutoff_hz", "rate_hz", "continuity", "lambda_r", "lambda_t", "variant",
-    "epsilon_r", "epsilon_t", "bound",  "gap",       "gap_intervals", "unit_tolerance"};
+    "epsilon_r", "epsilon_t", "bound",  "gap",       "gap_intervals", "unit_tolerance", "gyro_aided", "gyro_time_offset",
+    "gyro_estimate_offset", "gyro_mounting"};
 constexpr std::string_view kStreamKeys[] = {"id",     "name", "ring_capacity", "overflow", "driver", "engine",
                                             "spline", "gpio", "fusion",        "mounting", "world"};
 constexpr std::string_view kGpioKeys[] = {"chip",          "data_ready_line", "edge",        "bias",         "tolerance_min",
@@ -324,6 +325,10 @@ struct EngineLayer {
       lambda_t, epsilon_r, epsilon_t, gap, gap_intervals, unit_tolerance;
   std::optional<Given<OperatorVariant>> variant;
   std::optional<Given<BoundPolicy>> bound;
+  // Gyro-aided fairing (core/gyro_aiding.hpp).
+  std::optional<Given<bool>> gyro_aided, gyro_estimate_offset;
+  std::optional<Given<double>> gyro_time_offset;
+  std::optional<Given<Quat>> gyro_mounting;
 };
 
 class Parser {
@@ -568,6 +573,18 @@ class Parser {
     real("gap", e.gap, kPositive);
     real("gap_intervals", e.gap_intervals, kNonNegative);
     real("unit_tolerance", e.unit_tolerance, FloatRange{0.0, true, 1.0, true});
+    for (auto [name, field] : {std::pair{"gyro_aided", &e.gyro_aided}, std::pair{"gyro_estimate_offset", &e.gyro_estimate_offset}})
+      if (const toml::node* n = t.get(name)) {
+        const std::string key = join_key(prefix, name);
+        *field = Given<bool>{get_bool(*n, key), where(*n, key)};
+      }
+    const GyroAidingSettings gyro_defaults;
+    real("gyro_time_offset", e.gyro_time_offset,
+         FloatRange{-gyro_defaults.max_time_offset_s, false, gyro_defaults.max_time_offset_s, false});
+    if (const toml::node* n = t.get("gyro_mounting")) {
+      const std::string key = join_key(prefix, "gyro_mounting");
+      e.gyro_mounting = Given<Quat>{get_rotation(*n, key), where(*n, key)};
+    }
 
     if (e.cutoff_hz) {
       for (const auto* other : {&e.smoothing, &e.smoothing_r, &e.smoothing_t}) {
@@ -620,6 +637,10 @@ class Parser {
       take(layer->gap, c.gate.gap_threshold, EngineSetting::GapThreshold);
       take(layer->gap_intervals, c.gate.gap_intervals, EngineSetting::GapThreshold);
       take(layer->unit_tolerance, c.gate.unit_tolerance, EngineSetting::UnitTolerance);
+      if (layer->gyro_aided) c.gyro.enabled = layer->gyro_aided->value;
+      if (layer->gyro_estimate_offset) c.gyro.estimate_time_offset = layer->gyro_estimate_offset->value;
+      if (layer->gyro_time_offset) c.gyro.time_offset_s = layer->gyro_time_offset->value;
+      if (layer->gyro_mounting) c.gyro.mounting = layer->gyro_mounting->value;
       if (layer->epsilon_r) {
         // Given as a rotation angle; the engine's bound is the distance on S³, half of it.
         c.epsilon_r = layer->epsilon_r->value / 2.0;
@@ -1156,6 +1177,9 @@ class Parser {
     s.engine = build_engine(global, local ? &*local : nullptr, driver_rate, t, prefix, s.name);
     if (const toml::node* n = t.get("spline")) s.spline = parse_spline(table_of(*n, key("spline"), "[stream.spline]"), key("spline"));
     if (const toml::node* n = t.get("fusion")) s.fusion = parse_fusion(table_of(*n, key("fusion"), "[stream.fusion]"), key("fusion"));
+    // A fusion stage's orientation is already the gyro's integral: its gyro aids the fairing
+    // only when a table asks for it.
+    if (s.fusion && !global.gyro_aided && !(local && local->gyro_aided)) s.engine.gyro.enabled = false;
     if (const toml::node* n = t.get("gpio")) {
       std::optional<Given<double>> rate = local && local->rate_hz ? local->rate_hz : driver_rate ? driver_rate : global.rate_hz;
       s.gpio = parse_gpio(table_of(*n, key("gpio"), "[stream.gpio]"), key("gpio"), rate);

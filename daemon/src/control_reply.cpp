@@ -98,6 +98,15 @@ std::string streams_member(const std::vector<StreamStats>& now, const std::vecto
                                    .add("window", std::to_string(s.engine.window))
                                    .add("rotation", channel(s.engine.rotation))
                                    .add("position", channel(s.engine.position))
+                                   .add("gyro", JsonObject()
+                                                    .add("active", s.engine.gyro.active)
+                                                    .number("bias_x_rad_s", s.engine.gyro.bias.x())
+                                                    .number("bias_y_rad_s", s.engine.gyro.bias.y())
+                                                    .number("bias_z_rad_s", s.engine.gyro.bias.z())
+                                                    .number("time_offset_s", s.engine.gyro.time_offset_s)
+                                                    .add("time_offset_estimated", s.engine.gyro.offset_estimated)
+                                                    .add("intervals", s.engine.gyro.intervals)
+                                                    .str())
                                    .str();
     if (i) list += ',';
     list += JsonObject()

@@ -90,6 +90,13 @@ void store_engine_state(StreamCounters& c, const EngineState& e) {
     to.smoothing.store(from.smoothing, relaxed);
     to.cutoff_hz.store(from.cutoff_hz, relaxed);
   }
+  c.gyro.active.store(e.gyro.active, relaxed);
+  c.gyro.offset_estimated.store(e.gyro.offset_estimated, relaxed);
+  c.gyro.bias_x.store(e.gyro.bias.x(), relaxed);
+  c.gyro.bias_y.store(e.gyro.bias.y(), relaxed);
+  c.gyro.bias_z.store(e.gyro.bias.z(), relaxed);
+  c.gyro.time_offset_s.store(e.gyro.time_offset_s, relaxed);
+  c.gyro.intervals.store(e.gyro.intervals, relaxed);
 }
 
 EngineState load_engine_state(const StreamCounters& c) {
@@ -106,6 +113,11 @@ EngineState load_engine_state(const StreamCounters& c) {
     to.smoothing = from.smoothing.load(relaxed);
     to.cutoff_hz = from.cutoff_hz.load(relaxed);
   }
+  e.gyro.active = c.gyro.active.load(relaxed);
+  e.gyro.offset_estimated = c.gyro.offset_estimated.load(relaxed);
+  e.gyro.bias = Vec3(c.gyro.bias_x.load(relaxed), c.gyro.bias_y.load(relaxed), c.gyro.bias_z.load(relaxed));
+  e.gyro.time_offset_s = c.gyro.time_offset_s.load(relaxed);
+  e.gyro.intervals = c.gyro.intervals.load(relaxed);
   return e;
 }
 

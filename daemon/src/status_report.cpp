@@ -76,6 +76,15 @@ std::string engine_text(const EngineState& e) {
   channel("rotation", e.rotation, "rad");
   // Positions once the adaptation has measured some (a stream without them shows none).
   if (e.position.adaptive ? e.position.noise > 0.0 : e.position.smoothing > 0.0) channel("position", e.position, "units");
+  // Gyro-aided fairing, once it has seen a gyro.
+  if (e.gyro.intervals > 0) {
+    constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
+    std::snprintf(buf, sizeof buf, ", gyro-aided%s: bias (%.3f %.3f %.3f) deg/s, time offset %.2f ms (%s), intervals %" PRIu64,
+                  e.gyro.active ? "" : " (not now)", e.gyro.bias.x() * kDegPerRad, e.gyro.bias.y() * kDegPerRad,
+                  e.gyro.bias.z() * kDegPerRad, 1e3 * e.gyro.time_offset_s, e.gyro.offset_estimated ? "estimated" : "configured",
+                  e.gyro.intervals);
+    text += buf;
+  }
   return text;
 }
 
@@ -151,6 +160,12 @@ std::string status_line(const std::vector<StreamStats>& now, const std::vector<S
     }
     if (s.raw_unfused > 0) {
       std::snprintf(buf, sizeof buf, " raw-only %" PRIu64 " unfused", s.raw_unfused);
+      out += buf;
+    }
+    // Gyro-aided fairing: its time offset and the size of its bias estimate.
+    if (s.engine.gyro.active) {
+      std::snprintf(buf, sizeof buf, " gyro dt %.1fms bias %.2fdeg/s", 1e3 * s.engine.gyro.time_offset_s,
+                    s.engine.gyro.bias.norm() * 180.0 / 3.14159265358979323846);
       out += buf;
     }
     // A device stream says when its device is away and how often it went: what `systemctl

@@ -1300,6 +1300,40 @@ id = 1
 name = "a"
 driver = { type = "synthetic", rate_hz = 100 }
 )", "engine.horizon: a horizon (prediction) cannot be combined with an epsilon bound", 3},
+    {"gyro_aided not a boolean", R"([engine]
+gyro_aided = "yes"
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+)", "engine.gyro_aided: expected a boolean, got a string", 2},
+    {"gyro_estimate_offset not a boolean", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+engine = { gyro_estimate_offset = 1 }
+)", "stream[1].engine.gyro_estimate_offset: expected a boolean, got an integer", 5},
+    {"gyro_time_offset out of range", R"([engine]
+gyro_time_offset = 0.2
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+)", "engine.gyro_time_offset: out of range: must be in [-0.05, 0.05], got 0.2", 2},
+    {"gyro_time_offset not a number", R"([engine]
+gyro_time_offset = "4ms"
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+)", "engine.gyro_time_offset: expected a number, got a string", 2},
+    {"gyro_mounting not a rotation", R"([engine]
+gyro_mounting = [0, 90]
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+)", "engine.gyro_mounting: ", 2},
     {"window_time out of range", R"([engine]
 window_time = 0
 [[stream]]

@@ -34,6 +34,7 @@
 #include "posefair/formats/sample_log.hpp"
 
 #include "../support/counting_allocator.hpp"
+#include "../support/gyro_tracker_motion.hpp"
 #include "../support/test_files.hpp"
 #include "../support/udp_collector.hpp"
 
@@ -114,6 +115,17 @@ PipelineRun run_pipeline(const std::string& driver, const std::string& solver, c
   return run;
 }
 
+// Writes samples (stream 1) to a sample log at path; the replay driver's table body for it.
+std::string replay_of(const std::filesystem::path& path, const std::vector<Sample>& samples) {
+  formats::SampleLogHeader h;
+  h.streams = {{1, "imu", "test"}};
+  formats::SampleLogWriterOptions o;
+  o.sync = false;
+  formats::SampleLogWriter w(path, h, o);
+  for (const Sample& s : samples) w.append(s);
+  return "type = \"replay\"\npath = \"" + path.string() + "\"\ntiming = \"fast\"\n";
+}
+
 std::string describe(const PipelineRun& run) {
   std::ostringstream s;
   s << "slots:";
@@ -167,25 +179,17 @@ TEST_F(PipelineAllocation, ReplayToABinaryOutputAllocatesNothingOnTheRealtimeThr
 // the engine's raw-only path, which counts and skips, allocates nothing either.
 TEST_F(PipelineAllocation, RawOnlySamplesAllocateNothingOnTheRealtimeThreads) {
   testing::ScratchDir dir;
-  {
-    formats::SampleLogHeader h;
-    h.streams = {{1, "imu", "test"}};
-    formats::SampleLogWriterOptions o;
-    o.sync = false;
-    formats::SampleLogWriter w(dir / "raw.pflog", h, o);
-    for (std::uint64_t i = 0; i < 1000; ++i) {
-      Sample s;
-      s.stream_id = 1;
-      s.sequence = i;
-      s.time = 0.005 * static_cast<double>(i);
-      s.flags = (i % 2 ? kNoOrientation : 0u) | kHasGyro | kHasAccel;
-      s.gyro = Vec3(0, 0, 0.5);
-      s.accel = Vec3(0, 0, 9.81);
-      w.append(s);
-    }
+  std::vector<Sample> samples(1000);
+  for (std::uint64_t i = 0; i < samples.size(); ++i) {
+    Sample& s = samples[i];
+    s.stream_id = 1;
+    s.sequence = i;
+    s.time = 0.005 * static_cast<double>(i);
+    s.flags = (i % 2 ? kNoOrientation : 0u) | kHasGyro | kHasAccel;
+    s.gyro = Vec3(0, 0, 0.5);
+    s.accel = Vec3(0, 0, 9.81);
   }
-  const PipelineRun run =
-      run_pipeline("type = \"replay\"\npath = \"" + (dir / "raw.pflog").string() + "\"\ntiming = \"fast\"\n", "linear", "binary");
+  const PipelineRun run = run_pipeline(replay_of(dir / "raw.pflog", samples), "linear", "binary");
   SCOPED_TRACE(describe(run));
   EXPECT_TRUE(run.ended);
   ASSERT_EQ(run.threads, 2);
@@ -193,6 +197,26 @@ TEST_F(PipelineAllocation, RawOnlySamplesAllocateNothingOnTheRealtimeThreads) {
   EXPECT_EQ(run.stats.received, 1000u);
   EXPECT_EQ(run.stats.raw_unfused, 500u);
   EXPECT_EQ(run.stats.published, 500u);
+}
+
+// Orientations that carry a gyroscope reading: gyro-aided fairing, with its bias and time
+// offset estimates, on the engine thread, allocates nothing either.
+TEST_F(PipelineAllocation, GyroAidedFairingAllocatesNothingOnTheRealtimeThreads) {
+  posefair::testing::ScratchDir dir;
+  posefair::testing::GyroTrackerSpec spec;
+  spec.seconds = 5.0;
+  spec.offset = 0.004;
+  spec.bias = Vec3(0.01, 0.0, -0.02);
+  const PipelineRun run = run_pipeline(
+      replay_of(dir / "gyro.pflog", posefair::testing::make_gyro_tracker_stream(spec).samples), "linear", "binary");
+  SCOPED_TRACE(describe(run));
+  EXPECT_TRUE(run.ended);
+  ASSERT_EQ(run.threads, 2);
+  for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
+  EXPECT_EQ(run.stats.received, 1000u);
+  EXPECT_EQ(run.stats.published, 1000u);
+  EXPECT_TRUE(run.stats.engine.gyro.active);
+  EXPECT_GT(run.stats.engine.gyro.intervals, 900u);
 }
 
 TEST_F(PipelineAllocation, GaussNewtonOnASyntheticStreamAllocatesNothingOnTheRealtimeThreads) {

@@ -1,6 +1,7 @@
 // FairingWindow's promise that push() and flush() never allocate. This binary links
 // tests/support/counting_allocator.cpp, which replaces the global operator new/delete with
 // counting versions, so it must not share an executable with other tests.
+#include <cmath>
 #include <cstddef>
 #include <new>
 #include <string>
@@ -67,6 +68,7 @@ struct Case {
   BoundPolicy bound;
   bool defaults = false;  // the engine's defaults: the rate is measured, and W, the rows and
                           // the adaptation are set, inside the measured run
+  bool gyro = false;      // the samples carry a gyro: gyro-aided fairing with its estimates
 };
 
 TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
@@ -77,6 +79,7 @@ TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
       {"sweeps", WindowSolver::DampedSweeps, BoundPolicy::Sample},
       {"sweeps window bound", WindowSolver::DampedSweeps, BoundPolicy::Window},
       {"defaults (adaptive)", WindowSolver::Linear, BoundPolicy::Sample, true},
+      {"defaults, gyro-aided", WindowSolver::Linear, BoundPolicy::Sample, true, true},
   };
   constexpr std::size_t kWarmUp = 300, kMeasured = 10000;
   for (const Case& c : cases) {
@@ -99,9 +102,15 @@ TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
     EXPECT_GT(bytes, 0u);
 
     // Everything the measured loop touches exists before it starts.
-    const std::vector<Sample> warm = stream(c.defaults ? 3 : kWarmUp, 0.0, 1);
+    std::vector<Sample> warm = stream(c.defaults ? 3 : kWarmUp, 0.0, 1);
     std::vector<Sample> measured = stream(kMeasured, warm.back().time + 0.01, 2);
     for (std::size_t i = 4000; i < measured.size(); ++i) measured[i].time += 1.0;  // a gap: restart
+    if (c.gyro)
+      for (auto* part : {&warm, &measured})
+        for (std::size_t i = 0; i < part->size(); ++i) {
+          (*part)[i].gyro = Vec3(0.3 * std::sin(0.01 * static_cast<double>(i)), 0.2, -0.1);
+          (*part)[i].flags |= kHasGyro;
+        }
     Sample bad = measured[5000];
     bad.orientation.coeffs() *= 2.0;  // rejected by the gate
     std::vector<FairedPose> out(static_cast<std::size_t>(w.max_outputs_per_push()));
@@ -129,6 +138,10 @@ TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
     EXPECT_EQ(emitted, warm.size() + kMeasured);
     if (c.defaults) {
       EXPECT_GT(w.state().rate_hz, 0.0) << "the rate was never measured";
+    }
+    if (c.gyro) {
+      EXPECT_TRUE(w.state().gyro.active);
+      EXPECT_GT(w.state().gyro.intervals, kMeasured / 2);
     }
     EXPECT_EQ(w.counters().restarts, 1u);
     EXPECT_EQ(w.gate_counters().rejected_non_unit, 1u);

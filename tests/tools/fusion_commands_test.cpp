@@ -1,4 +1,4 @@
-// posefair fuse, calibrate and bench fusion end to end: the real binary on the BROAD excerpt
+// posefair fuse, calibrate, bench fusion and bench gyro-fairing end to end: the real binary on the BROAD excerpt
 // (tests/data/broad) and on hand-made recordings, and every bad-input case.
 #include <cmath>
 #include <fstream>
@@ -152,6 +152,34 @@ TEST(BenchFusionCommand, ScoresATrialPerTrialAndPerGroup) {
   EXPECT_THAT(r.out, HasSubstr("| fast | 1 |"));
   EXPECT_TRUE(std::filesystem::exists(dir / "out/fusion-trials.csv"));
   EXPECT_TRUE(std::filesystem::exists(dir / "out/fusion-groups.csv"));
+}
+
+TEST(BenchGyroFairingCommand, SaysWhereTheDataIsWhenItIsMissing) {
+  ScratchDir dir;
+  const auto r = run_posefair("bench gyro-fairing --data " + q(dir.path()), dir);
+  EXPECT_EQ(r.exit_code, 66);
+  EXPECT_THAT(r.err, HasSubstr("not found; it comes from BROAD"));
+  EXPECT_THAT(r.err, HasSubstr("POSEFAIR_DATA"));
+}
+
+TEST(BenchGyroFairingCommand, ScoresEachTrialAgainstFairingAloneAndOneEuroTunedOnTheOthers) {
+  ScratchDir dir;
+  std::filesystem::create_directories(dir / "data/broad");
+  // The excerpt as two trials (One Euro is tuned on the other one), its movement flag set.
+  std::ifstream in(kBroadFuseExcerpt);
+  std::string line, text;
+  while (std::getline(in, line)) text += (text.empty() ? line : line.substr(0, line.size() - 1) + "1") + "\n";
+  write_text(dir / "data/broad/07_undisturbed_fast_rotation_B.csv", text);
+  write_text(dir / "data/broad/02_undisturbed_slow_rotation_B.csv", text);
+  const auto r = run_posefair("bench gyro-fairing --seeds 1 --data " + q(dir / "data") + " -o " + q(dir / "out"), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("# Gyro-aided fairing on BROAD: 2 trials, 1 seeds"));
+  EXPECT_THAT(r.out, HasSubstr("## Jitter 0.5° RMS"));
+  EXPECT_THAT(r.out, HasSubstr("## Jitter 1.0° RMS"));
+  EXPECT_THAT(r.out, HasSubstr("| 07 |"));
+  EXPECT_THAT(r.out, HasSubstr("mincutoff="));  // the One Euro configuration picked on the other trial
+  EXPECT_THAT(r.out, HasSubstr("goal (every trial, both jitters): "));
+  EXPECT_TRUE(std::filesystem::exists(dir / "out/gyro-fairing-trials.csv"));
 }
 
 }  // namespace

@@ -31,6 +31,7 @@
 
 #include "posefair/core/banded_cholesky.hpp"
 #include "posefair/core/fairing_operators.hpp"
+#include "posefair/core/gyro_aiding.hpp"
 #include "posefair/core/sample.hpp"
 #include "posefair/core/sample_gate.hpp"
 #include "posefair/core/sliding_array.hpp"
@@ -67,6 +68,9 @@ struct WindowConfig {
   double epsilon_t = std::numeric_limits<double>::infinity();  // position units
   BoundPolicy bound = BoundPolicy::Sample;  // Window needs an iterative solver
   GateConfig gate;
+  // Samples with a gyroscope reading (kHasGyro) put the smoothness on the orientation's angular
+  // velocity minus the gyro's (gyro_aiding.hpp); linear solver, no horizon.
+  GyroAidingSettings gyro;
 };
 
 // Largest accepted smoothing weight μ (see validate()).
@@ -107,6 +111,7 @@ struct EngineState {
   double rate_hz = 0.0;    // given or measured; 0 until known
   int window = 0;          // W in use
   ChannelAdaptation rotation, position;
+  GyroAidingState gyro;
 };
 
 class FairingWindow {
@@ -144,6 +149,9 @@ class FairingWindow {
   };
 
   void append(const Sample& s);
+  bool gyro_aided(const Sample& s) const;
+  // What the rotation rows apply to: the measured increments ζ, or with a gyro their residual.
+  const SlidingArray<Vec3>& rotation_increments() const { return aided_ ? residual_ : zeta_; }
   void note_interval(double dt);
   bool needs_rate() const;
   void prepare(double rate_hz);
@@ -170,6 +178,7 @@ class FairingWindow {
   int w_ = 0;              // W in use (capacity_ until the rate is known)
   int n_ = 0;              // samples in the window
   bool positions_ = false; // this window carries positions (all its samples do)
+  bool aided_ = false;     // this window is gyro-aided (all its samples carry a gyro)
   bool have_emitted_ = false;
   Quat last_emitted_ = Quat::Identity();
   double last_time_ = 0.0;
@@ -188,12 +197,17 @@ class FairingWindow {
   int level_count_ = 0;
   EmissionRow fill_row_;             // scratch: the row of a window still filling
   Channel rot_, pos_;
+  GyroAiding gyro_;
+  // The rotation's adaptation while gyro-aided: the residual is slow, so its motion is fitted
+  // over the whole window (a shorter fit passes so much noise that it would pass for motion).
+  MotionNoiseEstimator aided_estimator_;
 
   // Per sample, index 0 = oldest.
   SlidingArray<Sample> samples_;   // as accepted (time, ids, measured values with their own sign)
   SlidingArray<Quat> z_;           // measurement, hemisphere-continuous
   SlidingArray<Quat> x_;           // current estimate (iterative solvers)
   SlidingArray<Vec3> zeta_;        // ζ_j = log(z_j⁻¹ z_{j+1}) (Linear)
+  SlidingArray<Vec3> residual_;    // ζ_j − g_j, the gyro-aided increments (Linear, aided)
   SlidingArray<Vec3> est_;         // e_i: estimate x_i = z_i exp(e_i) (Linear)
   SlidingArray<Vec3> c_;           // log(z_i⁻¹ y_i) of emitted samples (Linear)
   SlidingArray<Vec3> dzp_;         // p_{j+1} − p_j (Linear)

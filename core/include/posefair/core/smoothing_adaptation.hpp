@@ -34,6 +34,10 @@ struct AdaptationSettings {
   // only the motion's slower part, and smoothing too hard costs lag that the output never
   // makes up, while smoothing too little costs only the noise it leaves: so err light.
   double motion_margin = 2.0;
+  // Motion below the noise the fit lets through counts as that noise (a stream that only seems
+  // still is not smoothed without limit). Off for a gyro-aided residual, which is still by
+  // construction: there the fit's noise would pass for motion and cap the smoothing.
+  bool motion_floor = true;
 };
 
 // Noise and motion of one channel (rotation or position), from its differences ζ.

@@ -44,6 +44,15 @@ struct StreamCounters {
   std::atomic<double> engine_rate_hz{0.0};
   std::atomic<int> engine_window{0};
   Channel rotation, position;
+  // Gyro-aided fairing (EngineState::gyro): whether the window uses a gyro now, and its
+  // estimated bias and time offset.
+  struct Gyro {
+    std::atomic<bool> active{false}, offset_estimated{false};
+    std::atomic<double> bias_x{0.0}, bias_y{0.0}, bias_z{0.0};  // rad/s, gyro frame
+    std::atomic<double> time_offset_s{0.0};
+    std::atomic<std::uint64_t> intervals{0};
+  };
+  Gyro gyro;
   // [stream.fusion]: the estimator's state and counters (EstimatorState), written by the
   // engine thread after each batch.
   struct Fusion {
@@ -67,7 +76,7 @@ struct StreamStats {
   std::uint64_t raw_unfused = 0;  // raw-only samples not faired (no orientation, no fusion stage); still recorded
   std::uint64_t publish_dropped = 0, published = 0, send_failures = 0, recorded = 0, record_dropped = 0;
   HistogramSnapshot latency;
-  EngineState engine;      // rate, window, and the adaptation's noise, motion and cutoff
+  EngineState engine;      // rate, window, the adaptation's noise, motion and cutoff, and the gyro aiding's estimates
   bool bridging = false, resampling = false;  // [stream.spline] parts configured
   std::uint64_t bridged_gaps = 0, bridged_samples = 0, resampled = 0;
   bool matrix_lerp = false;  // [stream.spline] pose_interpolation = "matrix-lerp"
