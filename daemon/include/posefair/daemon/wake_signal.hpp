@@ -10,6 +10,12 @@
 //   producer:  publish the work (release), then s.notify();
 //
 // One consumer per signal; any number of producers.
+//
+// Batched (the default, [daemon] wake = "per-batch"): the first notify() that finds the consumer
+// asleep takes the sleeping flag and makes the one FUTEX_WAKE; the notifies of the rest of a
+// burst (16 trackers on one sync line, a driver that read several frames) see the consumer
+// already woken and make none, however long the woken thread takes to be scheduled.
+// Per sample ("per-sample"): every notify() while the flag is still up makes a FUTEX_WAKE.
 #include <linux/futex.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -17,10 +23,14 @@
 #include <atomic>
 #include <cstdint>
 
+#include "posefair/daemon/adaptive_spin.hpp"
+
 namespace posefair::daemon {
 
 class WakeSignal {
  public:
+  explicit WakeSignal(bool batched = true) : batched_(batched) {}
+
   // Read before looking for work: a notify() after this makes wait(seen) return at once.
   std::uint32_t prepare() const { return count_.load(std::memory_order_seq_cst); }
 
@@ -34,9 +44,17 @@ class WakeSignal {
     sleeping_.store(false, std::memory_order_relaxed);
   }
 
+  // wait(seen), after spinning (bounded, adaptive) for a notify() that makes parking needless.
+  void wait(std::uint32_t seen, AdaptiveSpin& spin) {
+    if (spin.spin([&] { return count_.load(std::memory_order_acquire) != seen; })) return;
+    wait(seen);
+  }
+
   void notify() {
     count_.fetch_add(1, std::memory_order_seq_cst);
-    if (sleeping_.load(std::memory_order_seq_cst))
+    // Batched: exchange, so only one of several notifiers wakes (the consumer rechecks
+    // everything once it runs). A late FUTEX_WAKE can at worst end a later wait early.
+    if (batched_ ? sleeping_.exchange(false, std::memory_order_seq_cst) : sleeping_.load(std::memory_order_seq_cst))
       ::syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&count_), FUTEX_WAKE_PRIVATE, 1, nullptr, nullptr, 0);
   }
 
@@ -44,6 +62,7 @@ class WakeSignal {
   static_assert(sizeof(std::atomic<std::uint32_t>) == sizeof(std::uint32_t));
   alignas(64) std::atomic<std::uint32_t> count_{0};
   std::atomic<bool> sleeping_{false};
+  bool batched_;
 };
 
 }  // namespace posefair::daemon
