@@ -74,7 +74,7 @@ struct DaemonSettings {
   // and sent ahead of other work; 0 = normal scheduling. Needs CAP_SYS_NICE or an RLIMIT_RTPRIO
   // at least this high (the unit sets LimitRTPRIO); refused, it is logged and the daemon runs on.
   int realtime_priority = 0;
-  // How the pipeline's real-time threads hand work on (docs/operations.md, "Threads"; measured
+  // How the pipeline's real-time threads hand work on (docs/operations.md, "Threads and memory"; measured
   // side by side in docs/benchmarks.md, "Latency by stage"):
   // which thread sends the faired poses: a publisher thread of its own, or the engine thread
   // right after fairing (no second hop).
