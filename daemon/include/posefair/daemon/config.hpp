@@ -78,9 +78,9 @@ struct DaemonSettings {
   // side by side in docs/benchmarks.md, "Latency by stage"):
   // which thread sends the faired poses: a publisher thread of its own, or the engine thread
   // right after fairing (no second hop).
-  PublishThread publish_on = PublishThread::Publisher;
+  PublishThread publish_on = PublishThread::Engine;
   // Bounded adaptive spin (µs) of the engine and publisher threads before they park; 0: park at once.
-  int spin_us = 0;
+  int spin_us = 50;
   // One FUTEX_WAKE per sleep of the woken thread (true), or one per notify while it sleeps.
   bool wake_per_batch = true;
   // CPUs the engine and publisher threads are pinned to (sched_setaffinity); empty: any.
