@@ -112,6 +112,14 @@ void print_human(const nlohmann::json& reply) {
                 reply["subscribers"].is_null() ? "port off" : num(reply["subscribers"]).c_str());
   }
   if (reply.contains("streams") && reply["streams"].is_array()) print_streams(reply["streams"]);
+  if (reply.contains("stages")) {
+    std::printf("%-10s %10s %8s %8s %8s %8s  (latency by stage since start, us)\n", "stage", "count", "p50", "p99", "p99.9", "max");
+    for (const char* name : {"ring_wait", "engine", "hand_off", "encode", "send"}) {
+      const auto& st = reply["stages"][name];
+      std::printf("%-10s %10s %8s %8s %8s %8s\n", name, num(st["count"]).c_str(), num(st["p50"]).c_str(), num(st["p99"]).c_str(),
+                  num(st["p999"]).c_str(), num(st["max"]).c_str());
+    }
+  }
   if (reply.contains("subscription")) {
     const auto& c = reply["subscription"];
     std::printf("subscription port %s: %s datagrams, %s cookies, %s subscribed, %s renewed, %s refused, dropped: %s not "

@@ -3,6 +3,8 @@
 // file, line, column and dotted key of the first problem.
 #include "posefair/daemon/config.hpp"
 
+#include <sched.h>
+
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -132,7 +134,8 @@ constexpr std::string_view kSubscriptionKeys[] = {"enabled", "listen", "allow", 
                                                   "rate_per_source", "burst_per_source", "source_table",
                                                   "max_lease", "psk_file"};
 constexpr std::string_view kControlKeys[] = {"enabled", "socket", "mode", "group"};
-constexpr std::string_view kDaemonKeys[] = {"exit_when_sources_end", "session_id", "realtime_priority"};
+constexpr std::string_view kDaemonKeys[] = {"exit_when_sources_end", "session_id", "realtime_priority", "publish_on",
+                                            "spin_us",               "wake",       "cpu_affinity"};
 constexpr std::string_view kLoggingKeys[] = {"level", "target", "status_interval"};
 constexpr std::string_view kEngineKeys[] = {
     "window",   "window_time", "max_window", "lag", "horizon", "order", "solver", "iterations", "smoothing", "smoothing_r",
@@ -140,7 +143,7 @@ constexpr std::string_view kEngineKeys[] = {
     "epsilon_r", "epsilon_t", "bound",  "gap",       "gap_intervals", "unit_tolerance", "gyro_aided", "gyro_time_offset",
     "gyro_estimate_offset", "gyro_mounting"};
 constexpr std::string_view kStreamKeys[] = {"id",     "name", "ring_capacity", "overflow", "driver", "engine",
-                                            "spline", "gpio", "fusion",        "mounting", "world"};
+                                            "spline", "gpio", "fusion",        "mounting", "world",  "busy_poll"};
 constexpr std::string_view kGpioKeys[] = {"chip",          "data_ready_line", "edge",        "bias",         "tolerance_min",
                                           "tolerance_max", "output_line",     "output_mode", "heartbeat_hz", "reconnect_min",
                                           "reconnect_max"};
@@ -270,7 +273,7 @@ struct ProtocolGiven : OptionsGiven {
 };
 
 constexpr std::string_view kOutputKeys[] = {"encoding", "destinations", "ttl",          "interface",
-                                            "loopback", "streams",      "angular_velocity", "max_rate_hz"};
+                                            "loopback", "streams",      "angular_velocity", "max_rate_hz", "sendmmsg"};
 constexpr std::string_view kRecorderKeys[] = {"path",  "enabled", "max_file_bytes", "flush_interval",
                                               "overwrite", "sync", "ring_capacity"};
 
@@ -491,6 +494,24 @@ class Parser {
     if (const toml::node* n = t.get("session_id")) d.session_id = get_u32(*n, join_key(prefix, "session_id"));
     if (const toml::node* n = t.get("realtime_priority"))
       d.realtime_priority = static_cast<int>(get_int(*n, join_key(prefix, "realtime_priority"), 0, 99));
+    if (const toml::node* n = t.get("publish_on"))
+      d.publish_on = get_choice<PublishThread>(*n, join_key(prefix, "publish_on"),
+                                               {{"engine", PublishThread::Engine}, {"publisher", PublishThread::Publisher}});
+    if (const toml::node* n = t.get("spin_us")) d.spin_us = static_cast<int>(get_int(*n, join_key(prefix, "spin_us"), 0, 10000));
+    if (const toml::node* n = t.get("wake"))
+      d.wake_per_batch = get_choice<bool>(*n, join_key(prefix, "wake"), {{"per-batch", true}, {"per-sample", false}});
+    if (const toml::node* n = t.get("cpu_affinity")) {
+      const std::string key = join_key(prefix, "cpu_affinity");
+      if (!n->is_array()) wrong_type(*n, key, "an array of CPU numbers");
+      const toml::array& cpus = *n->as_array();
+      for (std::size_t i = 0; i < cpus.size(); ++i) {
+        const std::string k = element_key(key, i);
+        const int cpu = static_cast<int>(get_int(cpus[i], k, 0, CPU_SETSIZE - 1));
+        if (std::find(d.cpu_affinity.begin(), d.cpu_affinity.end(), cpu) != d.cpu_affinity.end())
+          fail(cpus[i], k, "CPU " + std::to_string(cpu) + " is listed twice");
+        d.cpu_affinity.push_back(cpu);
+      }
+    }
     return d;
   }
 
@@ -1166,6 +1187,7 @@ class Parser {
         fail(name_node, key("name"), "duplicate stream name " + in_quotes(s.name) + " (also " + element_key("stream", i) + ")");
     }
     if (const toml::node* n = t.get("ring_capacity")) s.ring_capacity = get_ring_capacity(*n, key("ring_capacity"));
+    if (const toml::node* n = t.get("busy_poll")) s.busy_poll = get_bool(*n, key("busy_poll"));
     if (const toml::node* n = t.get("overflow"))
       s.overflow = get_choice<OverflowPolicy>(*n, key("overflow"), {{"drop-oldest", OverflowPolicy::DropOldest},
                                                                     {"drop-newest", OverflowPolicy::DropNewest}});
@@ -1371,7 +1393,7 @@ class Parser {
 
     if (encoding->own_transport) {
       // It finds its readers by its own discovery (DDS): the UDP keys would mean nothing.
-      for (std::string_view k : {"destinations", "ttl", "interface", "loopback"})
+      for (std::string_view k : {"destinations", "ttl", "interface", "loopback", "sendmmsg"})
         if (const toml::node* n = t.get(k))
           fail(*n, key(k), "has no meaning with encoding " + in_quotes(encoding->name) + ", which finds its readers by its own discovery");
     } else {
@@ -1381,6 +1403,7 @@ class Parser {
     if (const toml::node* n = t.get("ttl")) o.send.multicast_ttl = static_cast<int>(get_int(*n, key("ttl"), 0, 255));
     if (const toml::node* n = t.get("interface")) o.send.interface.name_or_address = get_nonempty_string(*n, key("interface"));
     if (const toml::node* n = t.get("loopback")) o.send.multicast_loopback = get_bool(*n, key("loopback"));
+    if (const toml::node* n = t.get("sendmmsg")) o.send.sendmmsg = get_bool(*n, key("sendmmsg"));
     if (const toml::node* n = t.get("angular_velocity")) o.angular_velocity = get_bool(*n, key("angular_velocity"));
     if (const toml::node* n = t.get("max_rate_hz")) o.max_rate_hz = get_float(*n, key("max_rate_hz"), kPositive);
     if (const toml::node* n = t.get("streams")) {

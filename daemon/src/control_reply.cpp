@@ -136,6 +136,26 @@ std::string streams_member(const std::vector<StreamStats>& now, const std::vecto
   return member("streams", list);
 }
 
+std::string stages_member(const StageLatencySnapshot& stages) {
+  const auto stage = [](const HistogramSnapshot& h) {
+    const auto us = [&](std::uint64_t ns) { return h.count ? json_number(static_cast<double>(ns) / 1000.0) : "null"; };
+    return JsonObject()
+        .add("count", h.count)
+        .add("p50", us(h.percentile(50)))
+        .add("p99", us(h.percentile(99)))
+        .add("p999", us(h.percentile(99.9)))
+        .add("max", us(h.max))
+        .str();
+  };
+  return member("stages", JsonObject()
+                              .add("ring_wait", stage(stages.ring_wait))
+                              .add("engine", stage(stages.engine))
+                              .add("hand_off", stage(stages.hand_off))
+                              .add("encode", stage(stages.encode))
+                              .add("send", stage(stages.send))
+                              .str());
+}
+
 std::string subscribers_member(const std::vector<SubscriberTable::Listed>& list, std::int64_t now_ns) {
   const auto entries = output_encoder_entries();
   std::string out = "[";

@@ -198,7 +198,12 @@ struct Pipeline::Stream final : drivers::SampleSink {
 Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
                    const std::map<std::uint32_t, std::uint64_t>& first_sequence, bool defer_recorder, PipelineHooks hooks,
                    std::shared_ptr<SubscriberTable> subscribers)
-    : config_(config), hooks_(std::move(hooks)) {
+    : config_(config),
+      hooks_(std::move(hooks)),
+      engine_wake_(config.daemon.wake_per_batch),
+      publisher_wake_(config.daemon.wake_per_batch),
+      engine_spin_(std::chrono::microseconds(config.daemon.spin_us)),
+      publisher_spin_(std::chrono::microseconds(config.daemon.spin_us)) {
   const bool record = config_.recorder.enabled;
   std::vector<std::uint32_t> ids;
   std::vector<StreamFrame> frames;
@@ -259,14 +264,27 @@ std::vector<std::string> Pipeline::start() {
   if (started_) return problems;
   started_ = true;
   engine_thread_ = std::thread([this] { engine_loop(); });
-  publisher_thread_ = std::thread([this] { publisher_loop(); });
+  if (!engine_publishes()) publisher_thread_ = std::thread([this] { publisher_loop(); });
+  std::vector<std::thread*> realtime{&engine_thread_};
+  if (publisher_thread_.joinable()) realtime.push_back(&publisher_thread_);
   if (const int prio = config_.daemon.realtime_priority; prio > 0) {
     sched_param sp{};
     sp.sched_priority = prio;
-    for (std::thread* t : {&engine_thread_, &publisher_thread_}) {
+    for (std::thread* t : realtime) {
       if (const int rc = ::pthread_setschedparam(t->native_handle(), SCHED_FIFO, &sp); rc != 0) {
         problems.push_back("realtime_priority " + std::to_string(prio) + " refused (" + std::strerror(rc) +
                            "): the engine runs with normal scheduling");
+        break;
+      }
+    }
+  }
+  if (!config_.daemon.cpu_affinity.empty()) {
+    cpu_set_t cpus;
+    CPU_ZERO(&cpus);
+    for (const int cpu : config_.daemon.cpu_affinity) CPU_SET(cpu, &cpus);
+    for (std::thread* t : realtime) {
+      if (const int rc = ::pthread_setaffinity_np(t->native_handle(), sizeof cpus, &cpus); rc != 0) {
+        problems.push_back(std::string("cpu_affinity refused (") + std::strerror(rc) + "): the engine runs on any CPU");
         break;
       }
     }
@@ -293,6 +311,11 @@ std::vector<std::string> Pipeline::start() {
   return problems;
 }
 
+bool Pipeline::busy_polling() const {
+  return std::any_of(streams_.begin(), streams_.end(),
+                     [](const auto& s) { return s->config.busy_poll && !s->driver_done.load(std::memory_order_relaxed); });
+}
+
 bool Pipeline::sources_ended() const { return started_ && drivers_running_.load(std::memory_order_acquire) == 0; }
 
 void Pipeline::stop(bool keep_recorder) {
@@ -311,7 +334,7 @@ void Pipeline::stop(bool keep_recorder) {
   engine_thread_.join();
   publisher_stop_.store(true, std::memory_order_release);
   wake_publisher();
-  publisher_thread_.join();
+  if (publisher_thread_.joinable()) publisher_thread_.join();
   for (auto& sp : streams_)
     if (sp->gpio.output) sp->gpio.output->stop();  // the line is free for the next pipeline
   if (recorder_thread_.joinable()) {
@@ -326,13 +349,41 @@ void Pipeline::stop(bool keep_recorder) {
 // when the stream is resampled. True when anything was handed on.
 bool Pipeline::emit(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns) {
   if (!s.resampler) {
-    s.pose_ring.push(pack(pose, s.index, enqueued_ns));
+    deliver(s, pose, enqueued_ns);
     return true;
   }
   const std::size_t n = s.resampler->push(pose, s.grid);
-  for (std::size_t i = 0; i < n; ++i) s.pose_ring.push(pack(s.grid[i], s.index, enqueued_ns));
+  for (std::size_t i = 0; i < n; ++i) deliver(s, s.grid[i], enqueued_ns);
   s.counters.resampled.fetch_add(n, std::memory_order_relaxed);
   return n > 0;
+}
+
+// Engine thread: a pose made, to the publisher's ring, or sent at once when the engine publishes.
+// The first pose of a sample ends the sample's engine stage.
+void Pipeline::deliver(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns) {
+  const std::uint64_t now = monotonic_ns();
+  if (!engine_stage_recorded_) {
+    stages_.engine.record(now - engine_pop_ns_);
+    engine_stage_recorded_ = true;
+  }
+  const RingPose p = pack(pose, s.index, enqueued_ns, now);
+  if (engine_publishes())
+    publish_pose(s, p, now);
+  else
+    s.pose_ring.push(p);
+}
+
+// The publishing thread (the publisher's, or the engine's): one pose sent and counted.
+void Pipeline::publish_pose(Stream& s, const RingPose& p, std::uint64_t popped_ns) {
+  const Publisher::Result res = publisher_->publish(p);
+  const std::uint64_t done = monotonic_ns();
+  s.counters.published.fetch_add(1, std::memory_order_relaxed);
+  if (s.gpio.output) s.gpio.output->on_pose();  // the scope's edge: this pose has been sent
+  if (res.failures) s.counters.send_failures.fetch_add(res.failures, std::memory_order_relaxed);
+  s.counters.latency.record(done - p.enqueued_ns);
+  if (!engine_publishes()) stages_.hand_off.record(popped_ns - p.faired_ns);
+  stages_.encode.record(res.encode_ns);
+  stages_.send.record(res.send_ns);
 }
 
 // Engine thread: one sample into the window, its faired poses handed on.
@@ -359,6 +410,8 @@ bool Pipeline::fair(Stream& s, const Sample& raw, std::uint64_t enqueued_ns) {
 // holds, then the window's lagged tail.
 void Pipeline::flush_stream(Stream& s) {
   const std::uint64_t now = monotonic_ns();
+  engine_pop_ns_ = now;
+  engine_stage_recorded_ = false;
   if (s.bridge) {
     const std::size_t n = s.bridge->flush(s.bridged);
     for (std::size_t i = 0; i < n; ++i) window_push(s, s.bridged[i], now);
@@ -380,6 +433,9 @@ void Pipeline::engine_loop() {
       bool emitted = false;
       for (int budget = kPopBudget; budget > 0 && s.ring.pop(r); --budget) {
         any = true;
+        engine_pop_ns_ = monotonic_ns();
+        engine_stage_recorded_ = false;
+        stages_.ring_wait.record(engine_pop_ns_ - r.enqueued_ns);
         if (hooks_.before_engine_sample) hooks_.before_engine_sample(s.config.id);
         const Sample sample = unpack(r);
         // A raw-only sample's quaternion is a placeholder, not a measurement: without a fusion
@@ -393,7 +449,7 @@ void Pipeline::engine_loop() {
       }
       // Wake the publisher after each stream's batch (not after the whole pass), so it works
       // alongside the engine instead of after it.
-      if (emitted) wake_publisher();
+      if (emitted && !engine_publishes()) wake_publisher();
       // The driver has ended and everything it delivered is in: hand over the lagged tail.
       if (!s.flushed && s.driver_done.load(std::memory_order_acquire) && s.ring.size_approx() == 0) {
         flush_stream(s);
@@ -419,11 +475,15 @@ void Pipeline::engine_loop() {
                                         std::memory_order_relaxed);
     }
     if (any) {
-      wake_publisher();
+      if (!engine_publishes()) wake_publisher();
       continue;
     }
     if (engine_stop_.load(std::memory_order_acquire)) return;
-    engine_wake_.wait(seen);
+    if (busy_polling()) {  // a busy_poll stream runs: look again at once, never park
+      cpu_relax();
+      continue;
+    }
+    engine_wake_.wait(seen, engine_spin_);
   }
 }
 
@@ -438,17 +498,12 @@ void Pipeline::publisher_loop() {
       RingPose p;
       for (int budget = kPopBudget; budget > 0 && s.pose_ring.pop(p); --budget) {
         any = true;
-        const Publisher::Result res = publisher_->publish(p);
-        const std::uint64_t done = monotonic_ns();
-        s.counters.published.fetch_add(1, std::memory_order_relaxed);
-        if (s.gpio.output) s.gpio.output->on_pose();  // the scope's edge: this pose has been sent
-        if (res.failures) s.counters.send_failures.fetch_add(res.failures, std::memory_order_relaxed);
-        s.counters.latency.record(done - p.enqueued_ns);
+        publish_pose(s, p, monotonic_ns());
       }
     }
     if (any) continue;
     if (publisher_stop_.load(std::memory_order_acquire)) return;
-    publisher_wake_.wait(seen);
+    publisher_wake_.wait(seen, publisher_spin_);
   }
 }
 

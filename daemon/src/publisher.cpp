@@ -80,15 +80,21 @@ Publisher::Result Publisher::publish(const RingPose& pose) {
     result.carried = true;
     if (!out.rate_limit.admit(pose.stream_index, pose.time)) continue;
     const OutputEncoder& encoder = *encoded_[out.encoded].encoder;
-    if (encoder.delivers()) {  // its own transport (DDS): no datagram, no destinations
+    const std::uint64_t t0 = monotonic_ns();
+    if (encoder.delivers()) {  // its own transport (DDS): no datagram, no destinations; counted as sending
       m.angular_velocity = out.angular_velocity ? rate : std::nullopt;
       if (!encoder.deliver(m)) ++result.failures;
+      result.send_ns += monotonic_ns() - t0;
       continue;
     }
-    const std::size_t sent = out.sender.send(datagram(out.encoded, m, rate, out.angular_velocity));
+    const std::span<const std::uint8_t> bytes = datagram(out.encoded, m, rate, out.angular_velocity);
+    const std::uint64_t t1 = monotonic_ns();
+    const std::size_t sent = out.sender.send(bytes);
+    result.encode_ns += t1 - t0;
+    result.send_ns += monotonic_ns() - t1;
     result.failures += out.sender.destinations().size() - sent;
   }
-  if (subscribers_) result.failures += publish_to_subscribers(m, rate);
+  if (subscribers_) result.failures += publish_to_subscribers(m, rate, result);
   return result;
 }
 
@@ -104,7 +110,7 @@ std::span<const std::uint8_t> Publisher::datagram(std::size_t index, PoseMessage
   return {e.buffer.data(), e.size};
 }
 
-std::size_t Publisher::publish_to_subscribers(PoseMessage& m, const std::optional<Vec3>& rate) {
+std::size_t Publisher::publish_to_subscribers(PoseMessage& m, const std::optional<Vec3>& rate, Result& timing) {
   subscribers_->refresh(subscriber_view_);
   const auto now = static_cast<std::int64_t>(monotonic_ns());
   std::size_t failures = 0;
@@ -112,7 +118,13 @@ std::size_t Publisher::publish_to_subscribers(PoseMessage& m, const std::optiona
     const Subscriber& s = subscriber_view_.entries[i];
     if (s.expires_ns <= now || !s.carries(m.stream)) continue;
     UdpSocket& socket = s.address.family() == AF_INET6 ? subscriber_v6_ : subscriber_v4_;
-    if (socket.is_open() && socket.send_to(datagram(subscriber_encoded_[s.encoding], m, rate, s.angular_velocity), s.address))
+    const std::uint64_t t0 = monotonic_ns();
+    const std::span<const std::uint8_t> bytes = datagram(subscriber_encoded_[s.encoding], m, rate, s.angular_velocity);
+    const std::uint64_t t1 = monotonic_ns();
+    const bool sent = socket.is_open() && socket.send_to(bytes, s.address);
+    timing.encode_ns += t1 - t0;
+    timing.send_ns += monotonic_ns() - t1;
+    if (sent)
       subscribers_->count_sent(subscriber_view_.slot[i], 1);
     else
       ++failures;

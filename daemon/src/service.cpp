@@ -296,6 +296,8 @@ class Service {
         return ok(subscribers_member(subscription_->table()->list(), now_ns));
       case ControlVerb::Counters: {
         std::string m = streams_member(pipeline_->stats(), last_status_stats_, seconds_since(last_status_));
+        m += ',';
+        m += stages_member(pipeline_->stage_latency());
         if (subscription_) {
           m += ',';
           m += subscription_member(subscription_->handler(), subscription_->table()->size());

@@ -416,9 +416,50 @@ UdpSender::UdpSender(std::vector<Endpoint> destinations, SendOptions options) : 
   const bool need6 = std::any_of(destinations_.begin(), destinations_.end(), [](const Endpoint& e) { return e.family() == AF_INET6; });
   if (need4) v4_ = UdpSocket::open(AF_INET, options);
   if (need6) v6_ = UdpSocket::open(AF_INET6, options);
+  batched_ = options.sendmmsg && destinations_.size() > 1;
+  if (!batched_) return;
+  for (const Endpoint& to : destinations_) {
+    Batch& b = to.family() == AF_INET ? batch4_ : batch6_;
+    ::mmsghdr h{};
+    h.msg_hdr.msg_name = const_cast<sockaddr*>(to.sockaddr_ptr());  // sendmmsg does not write it
+    h.msg_hdr.msg_namelen = to.sockaddr_len();
+    h.msg_hdr.msg_iovlen = 1;
+    b.headers.push_back(h);
+  }
+  for (Batch* b : {&batch4_, &batch6_}) {
+    b->iov.resize(b->headers.size());
+    for (std::size_t i = 0; i < b->headers.size(); ++i) b->headers[i].msg_hdr.msg_iov = &b->iov[i];
+  }
+}
+
+// Every header of the batch in as few sendmmsg calls as the kernel allows; a header the kernel
+// refuses is a failed send, and the rest are still sent.
+std::size_t UdpSender::send_batch(UdpSocket& socket, Batch& batch, std::span<const std::uint8_t> datagram) {
+  const std::size_t n = batch.headers.size();
+  if (n == 0) return 0;
+  if (!socket.is_open()) {
+    failures_ += n;
+    return 0;
+  }
+  for (::iovec& v : batch.iov) v = ::iovec{const_cast<std::uint8_t*>(datagram.data()), datagram.size()};
+  std::size_t ok = 0;
+  for (std::size_t next = 0; next < n;) {
+    const int sent = ::sendmmsg(socket.fd(), batch.headers.data() + next, static_cast<unsigned>(n - next), MSG_NOSIGNAL);
+    if (sent < 0 && errno == EINTR) continue;
+    if (sent <= 0) {  // the header at `next` failed: count it, go on with the next one
+      ++failures_;
+      ++next;
+      continue;
+    }
+    for (int i = 0; i < sent; ++i)
+      if (batch.headers[next + static_cast<std::size_t>(i)].msg_len == datagram.size()) ++ok; else ++failures_;
+    next += static_cast<std::size_t>(sent);
+  }
+  return ok;
 }
 
 std::size_t UdpSender::send(std::span<const std::uint8_t> datagram) {
+  if (batched_) return send_batch(v4_, batch4_, datagram) + send_batch(v6_, batch6_, datagram);
   std::size_t ok = 0;
   for (const Endpoint& to : destinations_) {
     UdpSocket& s = to.family() == AF_INET ? v4_ : v6_;

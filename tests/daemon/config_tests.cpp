@@ -310,6 +310,51 @@ TEST(Config, AFullConfigFillsEveryField) {
   EXPECT_EQ(loaded.recorder.path, dir.path() / "rec" / "out.pflog");
 }
 
+// [daemon] publish_on, spin_us, wake, cpu_affinity; [[stream]] busy_poll; [[output]] sendmmsg
+// (docs/config.md; measured in docs/benchmarks.md, "Latency by stage").
+TEST(Config, TheLatencyKeysChooseHowTheThreadsHandOver) {
+  const DaemonConfig c = parse_config(R"toml(
+[daemon]
+publish_on = "publisher"
+spin_us = 40
+wake = "per-sample"
+cpu_affinity = [1, 0]
+[[stream]]
+id = 1
+name = "a"
+busy_poll = true
+driver = { type = "synthetic" }
+[[stream]]
+id = 2
+name = "b"
+driver = { type = "synthetic" }
+[[output]]
+destinations = ["127.0.0.1:5700", "127.0.0.1:5701"]
+sendmmsg = false
+)toml",
+                                      "/nonexistent/latency.toml");
+  EXPECT_EQ(c.daemon.publish_on, PublishThread::Publisher);
+  EXPECT_EQ(c.daemon.spin_us, 40);
+  EXPECT_FALSE(c.daemon.wake_per_batch);
+  EXPECT_EQ(c.daemon.cpu_affinity, (std::vector<int>{1, 0}));
+  ASSERT_EQ(c.streams.size(), 2u);
+  EXPECT_TRUE(c.streams[0].busy_poll);
+  EXPECT_FALSE(c.streams[1].busy_poll);
+  ASSERT_EQ(c.outputs.size(), 1u);
+  EXPECT_FALSE(c.outputs[0].send.sendmmsg);
+
+  const DaemonConfig d = parse_config("[[stream]]\nid = 1\nname = \"a\"\ndriver = { type = \"synthetic\" }\n"
+                                      "[[output]]\ndestinations = [\"127.0.0.1:5700\"]\n",
+                                      "/nonexistent/defaults.toml");
+  const DaemonSettings defaults;
+  EXPECT_EQ(d.daemon.publish_on, defaults.publish_on);
+  EXPECT_EQ(d.daemon.spin_us, defaults.spin_us);
+  EXPECT_TRUE(d.daemon.wake_per_batch);
+  EXPECT_TRUE(d.daemon.cpu_affinity.empty());
+  EXPECT_FALSE(d.streams[0].busy_poll);
+  EXPECT_TRUE(d.outputs[0].send.sendmmsg);
+}
+
 TEST(Config, AMinimalConfigGetsEveryDefault) {
   const DaemonConfig c = parse_config(R"toml(
 [[stream]]
@@ -2051,6 +2096,47 @@ id = 1
 name = "a"
 driver = { type = "replay", candump = "bus.log", protocol = "xsens-can", fd = true }
 )", "stream[1].driver.fd: unknown key for driver type replay (it belongs to type socketcan)", 4},
+    {"publish_on: not a thread", R"([daemon]
+publish_on = "driver"
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "daemon.publish_on", 2},
+    {"spin_us: out of range", R"([daemon]
+spin_us = 20000
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "daemon.spin_us", 2},
+    {"wake: unknown", R"([daemon]
+wake = "per-stream"
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "daemon.wake", 2},
+    {"cpu_affinity: a CPU twice", R"([daemon]
+cpu_affinity = [1, 1]
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "daemon.cpu_affinity[2]: CPU 1 is listed twice", 2},
+    {"cpu_affinity: not an array", R"([daemon]
+cpu_affinity = 1
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "daemon.cpu_affinity: expected an array of CPU numbers", 2},
+    {"busy_poll: not a bool", R"([[stream]]
+id = 1
+name = "a"
+busy_poll = 1
+driver = { type = "synthetic" }
+)", "stream[1].busy_poll", 4},
     {"a table that is not one", R"(daemon = 5
 [[stream]]
 id = 1

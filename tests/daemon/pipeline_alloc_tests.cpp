@@ -53,9 +53,9 @@ constexpr std::uint32_t kSession = 0x5eed0a11u;
 // One stream (id 1) with the given driver table body and engine keys, and one output to
 // 127.0.0.1:port with the given encoding.
 std::string config_text(std::uint16_t port, const std::string& driver, const std::string& solver,
-                        const std::string& encoding) {
-  return "[daemon]\nsession_id = " + std::to_string(kSession) +
-         "\n\n"
+                        const std::string& encoding, const std::string& daemon_keys) {
+  return "[daemon]\nsession_id = " + std::to_string(kSession) + "\n" + daemon_keys +
+         "\n"
          "[[stream]]\n"
          "id = 1\n"
          "name = \"alloc\"\n"
@@ -84,6 +84,7 @@ std::string replay_driver() { return "type = \"replay\"\npath = \"" + kDemoCsv.s
 struct PipelineRun {
   bool ended = false;                     // the source ended on its own
   int threads = 0;                        // real-time threads that claimed a counter slot
+  int expected_threads = 0;               // the engine, and the publisher unless the engine publishes
   std::vector<std::size_t> allocations;   // per claimed slot, over the whole run
   StreamStats stats;
   std::uint64_t datagrams = 0;
@@ -92,11 +93,12 @@ struct PipelineRun {
 // Runs the pipeline until its source ends, stops it (which joins the engine and publisher
 // threads) and reads what each real-time thread allocated.
 PipelineRun run_pipeline(const std::string& driver, const std::string& solver, const std::string& encoding,
-                         std::shared_ptr<SubscriberTable> subscribers = nullptr) {
+                         std::shared_ptr<SubscriberTable> subscribers = nullptr, const std::string& daemon_keys = "") {
   PipelineRun run;
   UdpCollector receiver;  // the output's destination; its thread claims no counter slot
   const DaemonConfig config =
-      parse_config(config_text(receiver.port(), driver, solver, encoding), "/virtual/pipeline-alloc.toml");
+      parse_config(config_text(receiver.port(), driver, solver, encoding, daemon_keys), "/virtual/pipeline-alloc.toml");
+  run.expected_threads = config.daemon.publish_on == PublishThread::Engine ? 1 : 2;
   PipelineHooks hooks;
   // Stateless, so calling it allocates nothing; claiming a slot does not allocate either.
   hooks.on_realtime_thread_start = [] { counting::claim_counter_slot(); };
@@ -167,12 +169,29 @@ TEST_F(PipelineAllocation, ReplayToABinaryOutputAllocatesNothingOnTheRealtimeThr
   std::printf("%s\n", describe(run).c_str());
   SCOPED_TRACE(describe(run));
   EXPECT_TRUE(run.ended) << "the replay did not end";
-  ASSERT_EQ(run.threads, 2) << "the engine and the publisher thread each claim a slot";
+  ASSERT_EQ(run.threads, run.expected_threads) << "the engine and the publisher thread each claim a slot";
   for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
   EXPECT_EQ(run.stats.received, kDemoSamples);
   EXPECT_EQ(run.stats.published, kDemoSamples);
   EXPECT_EQ(run.stats.send_failures, 0u);
   EXPECT_GT(run.datagrams, 0u);
+}
+
+// Each way of handing over ([daemon] publish_on, spin_us, wake; docs/config.md) allocates
+// nothing either: the spin, the batched wake and publishing from the engine thread are all
+// plain loads, stores and system calls.
+TEST_F(PipelineAllocation, EveryHandOverOptionAllocatesNothingOnTheRealtimeThreads) {
+  for (const char* keys : {"publish_on = \"engine\"\nspin_us = 100\n", "publish_on = \"publisher\"\nspin_us = 100\n",
+                           "publish_on = \"publisher\"\nwake = \"per-sample\"\n"}) {
+    SCOPED_TRACE(keys);
+    counting::release_counter_slots();
+    const PipelineRun run = run_pipeline(replay_driver(), "linear", "binary", nullptr, keys);
+    SCOPED_TRACE(describe(run));
+    EXPECT_TRUE(run.ended);
+    ASSERT_EQ(run.threads, run.expected_threads);
+    for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
+    EXPECT_EQ(run.stats.published, kDemoSamples);
+  }
 }
 
 // A raw IMU stream (every other sample raw-only, the rest orientations with their readings):
@@ -192,7 +211,7 @@ TEST_F(PipelineAllocation, RawOnlySamplesAllocateNothingOnTheRealtimeThreads) {
   const PipelineRun run = run_pipeline(replay_of(dir / "raw.pflog", samples), "linear", "binary");
   SCOPED_TRACE(describe(run));
   EXPECT_TRUE(run.ended);
-  ASSERT_EQ(run.threads, 2);
+  ASSERT_EQ(run.threads, run.expected_threads);
   for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
   EXPECT_EQ(run.stats.received, 1000u);
   EXPECT_EQ(run.stats.raw_unfused, 500u);
@@ -225,7 +244,7 @@ TEST_F(PipelineAllocation, GaussNewtonOnASyntheticStreamAllocatesNothingOnTheRea
   std::printf("%s\n", describe(run).c_str());
   SCOPED_TRACE(describe(run));
   EXPECT_TRUE(run.ended) << "the synthetic stream did not end";
-  ASSERT_EQ(run.threads, 2) << "the engine and the publisher thread each claim a slot";
+  ASSERT_EQ(run.threads, run.expected_threads) << "the engine and the publisher thread each claim a slot";
   for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
   EXPECT_EQ(run.stats.received, 1000u);  // 0.5 s at 2000 Hz
   EXPECT_EQ(run.stats.published, run.stats.received);
@@ -250,7 +269,7 @@ TEST_F(PipelineAllocation, BridgingAndResamplingAllocateNothingOnTheRealtimeThre
   std::printf("%s\n", describe(run).c_str());
   SCOPED_TRACE(describe(run));
   EXPECT_TRUE(run.ended) << "the replay did not end";
-  ASSERT_EQ(run.threads, 2) << "the engine and the publisher thread each claim a slot";
+  ASSERT_EQ(run.threads, run.expected_threads) << "the engine and the publisher thread each claim a slot";
   for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
   EXPECT_EQ(run.stats.received, kDemoSamples - 80);
   EXPECT_EQ(run.stats.bridged_gaps, 3u) << "the fourth dropout is the recording's end";
@@ -296,7 +315,7 @@ TEST_F(PipelineAllocation, MatrixLerpBridgingAndResamplingAllocateNothingOnTheRe
   std::printf("%s; lerp fallbacks %llu\n", describe(run).c_str(), static_cast<unsigned long long>(run.stats.lerp_fallbacks));
   SCOPED_TRACE(describe(run));
   EXPECT_TRUE(run.ended) << "the replay did not end";
-  ASSERT_EQ(run.threads, 2) << "the engine and the publisher thread each claim a slot";
+  ASSERT_EQ(run.threads, run.expected_threads) << "the engine and the publisher thread each claim a slot";
   for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
   EXPECT_EQ(run.stats.bridged_gaps, 3u);
   EXPECT_TRUE(run.stats.matrix_lerp);
@@ -342,11 +361,12 @@ TEST_F(PipelineAllocation, TheFusionStageAllocatesNothingPerSample) {
 }
 
 TEST_F(PipelineAllocation, AJsonOutputAllocatesOnThePublisherThreadOnly) {
-  const PipelineRun run = run_pipeline(replay_driver(), "linear", "json");
+  // A publisher thread of its own, so that its allocations and the engine's are told apart.
+  const PipelineRun run = run_pipeline(replay_driver(), "linear", "json", nullptr, "publish_on = \"publisher\"\n");
   std::printf("%s\n", describe(run).c_str());
   SCOPED_TRACE(describe(run));
   EXPECT_TRUE(run.ended) << "the replay did not end";
-  ASSERT_EQ(run.threads, 2) << "the engine and the publisher thread each claim a slot";
+  ASSERT_EQ(run.threads, run.expected_threads) << "the engine and the publisher thread each claim a slot";
   EXPECT_GT(*std::max_element(run.allocations.begin(), run.allocations.end()), 0u)
       << "the publisher's JSON strings were not counted";
   EXPECT_EQ(*std::min_element(run.allocations.begin(), run.allocations.end()), 0u) << "the engine thread allocated";
@@ -389,7 +409,7 @@ TEST_F(PipelineAllocation, SendingToSubscribersAllocatesNothingOnTheRealtimeThre
   std::printf("%s; renewals %u, subscriber datagrams %zu\n", describe(run).c_str(), renewals.load(), subscriber.datagrams());
   SCOPED_TRACE(describe(run));
   EXPECT_TRUE(run.ended);
-  ASSERT_EQ(run.threads, 2);
+  ASSERT_EQ(run.threads, run.expected_threads);
   for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
   EXPECT_GT(renewals.load(), 10u);
   EXPECT_EQ(run.stats.send_failures, 0u);

@@ -444,6 +444,13 @@ TEST(ControlSocket, CommandsAnswerAndOnlyTheGroupGetsIn) {
   EXPECT_EQ(streams[0]["name"], "head");
   EXPECT_GT(streams[0]["emitted"].get<std::uint64_t>(), 0u);
   EXPECT_TRUE(streams[0]["latency_us"]["p99"].is_number());
+  // The latency by stage: every sample waited in a ring and was faired; the default has the
+  // engine publish (no hand-off), and what was sent was encoded.
+  const auto stages = nlohmann::json::parse(d.ctl({"counters"}).second)["stages"];
+  EXPECT_GT(stages["ring_wait"]["count"].get<std::uint64_t>(), 0u) << stages.dump();
+  EXPECT_TRUE(stages["engine"]["p99"].is_number()) << stages.dump();
+  EXPECT_EQ(stages["send"]["count"], stages["encode"]["count"]) << stages.dump();
+  EXPECT_GT(stages["send"]["count"].get<std::uint64_t>(), 0u) << stages.dump();
   // The human table.
   Subprocess table({kPosefair, "ctl", "--socket", d.socket().string(), "streams"}, d.dir() / "t.out", d.dir() / "t.err");
   EXPECT_EQ(table.wait(10s), 0);

@@ -168,6 +168,40 @@ TEST(UdpSender, SendsOneDatagramToEveryDestination) {
   EXPECT_EQ(sender.failures(), 0u);
 }
 
+// Several destinations of one family go out in one sendmmsg(2) (SendOptions::sendmmsg, the
+// default), or one sendto each: every destination gets the datagram once, either way, and a
+// mixed IPv4/IPv6 list is sent per family.
+TEST(UdpSender, SendmmsgAndSendtoReachEveryDestinationOnce) {
+  for (const bool batched : {true, false}) {
+    SCOPED_TRACE(batched ? "sendmmsg" : "sendto");
+    std::vector<UdpSocket> rx;
+    std::vector<Endpoint> to;
+    for (int i = 0; i < 5; ++i) {
+      rx.push_back(UdpSocket::bind(loopback_any_port()));
+      to.push_back(rx.back().local_endpoint());
+    }
+    bool six = true;
+    try {
+      rx.push_back(UdpSocket::bind(*Endpoint::parse("[::1]:0")));
+      to.insert(to.begin() + 2, rx.back().local_endpoint());  // between the IPv4 ones
+    } catch (const std::system_error&) {
+      six = false;  // no IPv6 loopback here: IPv4 only
+    }
+    SendOptions so;
+    so.sendmmsg = batched;
+    UdpSender sender(to, so);
+    for (const char* text : {"one", "two"}) EXPECT_EQ(sender.send(bytes(text)), to.size());
+    for (UdpSocket& r : rx) {
+      EXPECT_EQ(receive_string(r), "one");
+      EXPECT_EQ(receive_string(r), "two");
+      Bytes buf(16);
+      EXPECT_FALSE(r.receive(buf, 20ms).has_value()) << "a destination got a datagram twice";
+    }
+    EXPECT_EQ(sender.failures(), 0u);
+    EXPECT_EQ(rx.size(), six ? 6u : 5u);
+  }
+}
+
 TEST(UdpSocket, Ipv6Loopback) {
   UdpSocket rx;
   try {

@@ -62,6 +62,8 @@ struct LoggingConfig {
   double status_interval = 60.0;  // s between counter lines in the log (0: only on SIGUSR1 and exit)
 };
 
+enum class PublishThread { Publisher, Engine };
+
 struct DaemonSettings {
   // Exit (status 0) once every driver has ended and every pose is out, e.g. a replay without
   // loop. Off for a service: a finished source then just idles.
@@ -72,6 +74,17 @@ struct DaemonSettings {
   // and sent ahead of other work; 0 = normal scheduling. Needs CAP_SYS_NICE or an RLIMIT_RTPRIO
   // at least this high (the unit sets LimitRTPRIO); refused, it is logged and the daemon runs on.
   int realtime_priority = 0;
+  // How the pipeline's real-time threads hand work on (docs/operations.md, "Threads and memory"; measured
+  // side by side in docs/benchmarks.md, "Latency by stage"):
+  // which thread sends the faired poses: a publisher thread of its own, or the engine thread
+  // right after fairing (no second hop).
+  PublishThread publish_on = PublishThread::Engine;
+  // Bounded adaptive spin (µs) of the engine and publisher threads before they park; 0: park at once.
+  int spin_us = 50;
+  // One FUTEX_WAKE per sleep of the woken thread (true), or one per notify while it sleeps.
+  bool wake_per_batch = true;
+  // CPUs the engine and publisher threads are pinned to (sched_setaffinity); empty: any.
+  std::vector<int> cpu_affinity;
 };
 
 // [stream.driver] with type = "socketcan": trackers on a CAN bus (drivers/socketcan_driver.hpp),
@@ -185,6 +198,7 @@ struct FusionConfig {
 
 struct StreamConfig {
   std::uint32_t id = 0;           // unique; the wire protocol's stream id
+  bool busy_poll = false;         // the engine never parks while this stream's driver runs
   std::string name;               // unique, non-empty; for logs, STATUS= and the recording's stream table
   DriverConfig driver;
   std::uint32_t ring_capacity = 1024;  // samples; a power of two, 2 .. 1048576

@@ -5,8 +5,11 @@
 //   stream) ─► publisher thread ─► UDP;   driver thread ─► ring (per stream) ─► recorder thread
 //
 // The engine thread owns every FairingWindow and never blocks, allocates or logs; it sleeps on
-// a futex (WakeSignal) only when every ring is empty. The publisher is fed through
-// rings too, so a slow network cannot stall the engine. Each ring's overflow is counted.
+// a futex (WakeSignal) only when every ring is empty (after a bounded adaptive spin with
+// [daemon] spin_us, never while a busy_poll stream runs). With [daemon] publish_on = "engine"
+// it sends the poses itself, right after fairing (no second hop, no publisher thread); with
+// "publisher" a publisher thread is fed through rings, so a slow network cannot stall the
+// engine. Each ring's overflow is counted. Every stage's latency is kept (stage_latency.hpp).
 // A SIGHUP reload builds a new Pipeline from the new config while the old one runs, then stops
 // the old one (drained) and starts the new one: the swap is whole.
 #include <atomic>
@@ -18,7 +21,10 @@
 #include <thread>
 #include <vector>
 
+#include "posefair/daemon/adaptive_spin.hpp"
 #include "posefair/daemon/config.hpp"
+#include "posefair/daemon/ring_items.hpp"
+#include "posefair/daemon/stage_latency.hpp"
 #include "posefair/daemon/stream_counters.hpp"
 #include "posefair/daemon/subscriber_table.hpp"
 #include "posefair/daemon/wake_signal.hpp"
@@ -60,6 +66,8 @@ class Pipeline {
   bool sources_ended() const;
 
   std::vector<StreamStats> stats() const;
+  // Latency by stage over every stream since start (docs/benchmarks.md, "Latency by stage").
+  StageLatencySnapshot stage_latency() const { return stages_.snapshot(); }
   // Before start(): continue the wire sequence numbers from a stopped pipeline's (a reload).
   void continue_sequences(const std::map<std::uint32_t, std::uint64_t>& next_sequence);
   // The wire sequence number each stream continues from (after stop()).
@@ -92,9 +100,13 @@ class Pipeline {
   struct Stream;
   void engine_loop();
   bool emit(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns);
+  void deliver(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns);
+  void publish_pose(Stream& s, const RingPose& pose, std::uint64_t popped_ns);
+  bool engine_publishes() const { return config_.daemon.publish_on == PublishThread::Engine; }
   bool window_push(Stream& s, const Sample& sample, std::uint64_t enqueued_ns);
   bool fair(Stream& s, const Sample& sample, std::uint64_t enqueued_ns);
   void flush_stream(Stream& s);
+  bool busy_polling() const;  // a busy_poll stream's driver still runs
   void publisher_loop();
   void recorder_loop();
   void wake_engine();
@@ -111,6 +123,10 @@ class Pipeline {
 
   WakeSignal engine_wake_;
   WakeSignal publisher_wake_;
+  AdaptiveSpin engine_spin_, publisher_spin_;  // each used by its own thread only
+  StageLatency stages_;
+  std::uint64_t engine_pop_ns_ = 0;    // engine thread: when the sample being faired was popped
+  bool engine_stage_recorded_ = false;  // engine thread: its engine stage is recorded
   std::atomic<std::uint64_t> heartbeat_{0};
   std::atomic<bool> engine_stop_{false};
   std::atomic<bool> publisher_stop_{false};

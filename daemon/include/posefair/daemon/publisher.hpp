@@ -38,6 +38,8 @@ class Publisher {
   struct Result {
     bool carried = false;           // at least one output carries this stream
     std::size_t failures = 0;       // failed sends (one per destination)
+    std::uint64_t encode_ns = 0;    // time spent encoding (every datagram of the pose)
+    std::uint64_t send_ns = 0;      // time spent sending (every send of the pose)
   };
   // Sends one pose now; send_time is CLOCK_REALTIME at the call.
   Result publish(const RingPose& pose);
@@ -76,7 +78,7 @@ class Publisher {
   // The datagram of encoded_[index] for m, encoded on first use for this pose.
   std::span<const std::uint8_t> datagram(std::size_t index, PoseMessage& m, const std::optional<Vec3>& rate, bool with_rate);
   // Sends m to the subscribers that carry its stream and whose lease runs; returns failed sends.
-  std::size_t publish_to_subscribers(PoseMessage& m, const std::optional<Vec3>& rate);
+  std::size_t publish_to_subscribers(PoseMessage& m, const std::optional<Vec3>& rate, Result& timing);
 
   std::uint32_t session_;
   std::vector<Output> outputs_;

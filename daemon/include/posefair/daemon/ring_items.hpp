@@ -32,6 +32,7 @@ struct RingPose {
   double q[4];
   double p[3];
   std::uint64_t enqueued_ns;   // hand-over time of the sample whose arrival emitted this pose
+  std::uint64_t faired_ns;     // CLOCK_MONOTONIC when the engine made it (for the hand-off stage)
 };
 static_assert(std::is_trivially_copyable_v<RingPose>);
 
@@ -72,13 +73,14 @@ inline Sample unpack(const RingSample& r) {
   return s;
 }
 
-inline RingPose pack(const FairedPose& f, std::uint32_t stream_index, std::uint64_t enqueued_ns) {
+inline RingPose pack(const FairedPose& f, std::uint32_t stream_index, std::uint64_t enqueued_ns, std::uint64_t faired_ns = 0) {
   return RingPose{stream_index,
                   f.flags,
                   f.time,
                   {f.orientation.w(), f.orientation.x(), f.orientation.y(), f.orientation.z()},
                   {f.position.x(), f.position.y(), f.position.z()},
-                  enqueued_ns};
+                  enqueued_ns,
+                  faired_ns};
 }
 
 }  // namespace posefair::daemon

@@ -6,6 +6,7 @@
 // IPv4 and IPv6. Errors at set-up throw std::system_error (errno as the code) with a message
 // naming the address; the receive and send paths never throw.
 #include <sys/socket.h>
+#include <sys/uio.h>
 
 #include <chrono>
 #include <cstddef>
@@ -68,6 +69,7 @@ struct SendOptions {
   int multicast_ttl = 1;  // IP_MULTICAST_TTL / IPV6_MULTICAST_HOPS: 1 = this link only
   MulticastInterface interface;  // outgoing interface for multicast
   bool multicast_loopback = true;  // IP_MULTICAST_LOOP: local subscribers see our multicast
+  bool sendmmsg = true;  // UdpSender: one sendmmsg per family for several destinations, not a sendto each
 };
 
 struct ReceivedDatagram {
@@ -122,7 +124,9 @@ class UdpSocket {
 
 // One datagram to a list of destinations, IPv4 and IPv6 mixed (one socket per family the list
 // needs, opened by the constructor, which throws std::system_error if it cannot). send() never
-// throws; failed sends are counted.
+// throws; failed sends are counted. With SendOptions::sendmmsg, the destinations of one family
+// are sent to in one sendmmsg(2) call (one system call instead of one per destination; the
+// message headers are built once, here).
 class UdpSender {
  public:
   explicit UdpSender(std::vector<Endpoint> destinations, SendOptions options = {});
@@ -132,8 +136,17 @@ class UdpSender {
   std::uint64_t failures() const { return failures_; }
 
  private:
+  // The destinations of one family, as sendmmsg's headers (their iovec filled per send).
+  struct Batch {
+    std::vector<::mmsghdr> headers;
+    std::vector<::iovec> iov;  // one per header, all pointing at the datagram being sent
+  };
+  std::size_t send_batch(UdpSocket& socket, Batch& batch, std::span<const std::uint8_t> datagram);
+
   std::vector<Endpoint> destinations_;
   UdpSocket v4_, v6_;
+  bool batched_ = false;
+  Batch batch4_, batch6_;
   std::uint64_t failures_ = 0;
 };
 
