@@ -132,8 +132,9 @@ class VqfEstimator final : public OrientationEstimator {
     // The rotation and the bias it carries into the earth frame, low-passed like the
     // accelerometer, so the correction's implied rate compares like with like.
     const Eigen::Matrix3d r = (q_acc_ * q_gyr_).toRotationMatrix();
-    Eigen::Matrix3d r_lp;
-    Eigen::Array2d bias_lp;
+    // Zero until set (only read when motion_bias set them; GCC cannot see that).
+    Eigen::Matrix3d r_lp = Eigen::Matrix3d::Zero();
+    Eigen::Array2d bias_lp = Eigen::Array2d::Zero();
     if (p_.motion_bias) {
       Eigen::Array<double, 9, 1> flat = Eigen::Map<const Eigen::Array<double, 9, 1>>(r.data());
       Eigen::Map<Eigen::Array<double, 9, 1>>(r_lp.data()) = motion_r_lp_.step(flat);
