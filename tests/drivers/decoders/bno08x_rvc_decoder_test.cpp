@@ -16,7 +16,7 @@
 #include "posefair/drivers/bno08x_rvc_decoder.hpp"
 #include "posefair/drivers/checksums.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::bno08x_rvc_decoder_test {
 namespace {
 
 using namespace ::posefair::testing;
@@ -330,4 +330,4 @@ TEST(Bno08xRvcDecoder, RandomBytes) {
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::bno08x_rvc_decoder_test

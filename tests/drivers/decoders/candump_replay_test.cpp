@@ -13,7 +13,7 @@
 #include "posefair/drivers/replay_driver.hpp"
 #include "posefair/formats/candump_log.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::candump_replay_test {
 namespace {
 
 using namespace ::posefair::testing;
@@ -91,4 +91,4 @@ TEST(CandumpReplay, ARecordedBusDecodesAndPlays) {
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::candump_replay_test

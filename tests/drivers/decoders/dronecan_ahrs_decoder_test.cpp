@@ -19,7 +19,7 @@
 #include "posefair/drivers/dronecan_ahrs_decoder.hpp"
 #include "posefair/drivers/float16.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::dronecan_ahrs_decoder_test {
 namespace {
 
 using namespace ::posefair::testing;
@@ -352,4 +352,4 @@ TEST(DroneCanAhrs, RandomPayloadsPassTheCrcAtItsFalseAcceptRate) {
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::dronecan_ahrs_decoder_test

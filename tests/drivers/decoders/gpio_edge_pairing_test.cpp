@@ -9,7 +9,7 @@
 
 #include "posefair/drivers/gpio_edge_pairing.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::gpio_edge_pairing_test {
 namespace {
 
 EdgePairingOptions window(double lo, double hi) {
@@ -196,4 +196,4 @@ TEST(GpioEdgePairing, OptionsOutOfRange) {
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::gpio_edge_pairing_test

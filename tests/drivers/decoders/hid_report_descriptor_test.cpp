@@ -23,7 +23,7 @@
 #include "../../support/hid_sensor_descriptor.hpp"
 #include "posefair/drivers/hid_report_descriptor.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::hid_report_descriptor_test {
 namespace {
 
 using namespace ::posefair::testing;
@@ -420,4 +420,4 @@ TEST(HidReportDescriptor, MutatedGenuineDescriptorsParseOrFailAtAnItem) {
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::hid_report_descriptor_test

@@ -17,7 +17,7 @@
 #include "../../support/hid_sensor_descriptor.hpp"
 #include "posefair/drivers/hid_sensor_orientation_decoder.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::hid_sensor_orientation_decoder_test {
 namespace {
 
 using namespace ::posefair::testing;
@@ -298,4 +298,4 @@ TEST(HidSensorOrientation, SamplesOfRandomReportsAreUnitQuaternions) {
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::hid_sensor_orientation_decoder_test

@@ -12,7 +12,7 @@
 #include "../../support/decoder_testing.hpp"
 #include "posefair/drivers/hid_vendor_layout_decoder.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::hid_vendor_layout_decoder_test {
 namespace {
 
 using namespace ::posefair::testing;
@@ -211,4 +211,4 @@ TEST(HidVendorLayout, TenMegabytesOfRandomReportsNeverCrash) {
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::hid_vendor_layout_decoder_test

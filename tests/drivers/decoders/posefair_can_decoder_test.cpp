@@ -13,7 +13,7 @@
 #include "../../support/can_decoder_testing.hpp"
 #include "posefair/drivers/posefair_can_decoder.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::posefair_can_decoder_test {
 namespace {
 
 using namespace ::posefair::testing;
@@ -370,4 +370,4 @@ TEST(PosefairCanDecoder, RandomQuaternionFramesPassTheNormCheckAtTheGeometricRat
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::posefair_can_decoder_test

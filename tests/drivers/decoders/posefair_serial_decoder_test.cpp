@@ -15,7 +15,7 @@
 #include "posefair/drivers/checksums.hpp"
 #include "posefair/drivers/posefair_serial_decoder.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::posefair_serial_decoder_test {
 namespace {
 
 using namespace ::posefair::testing;
@@ -508,4 +508,4 @@ TEST(PosefairSerialDecoder, RandomBytesAcceptedWithinTheChecksumRate) {
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::posefair_serial_decoder_test

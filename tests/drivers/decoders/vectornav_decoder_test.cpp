@@ -29,7 +29,7 @@
 #include "posefair/core/so3.hpp"
 #include "posefair/drivers/vectornav_decoder.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::vectornav_decoder_test {
 namespace {
 
 using namespace ::posefair::testing;
@@ -486,4 +486,4 @@ TEST(VectorNavCorpus, SeedFilesDecodeAsIntended) {
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::vectornav_decoder_test

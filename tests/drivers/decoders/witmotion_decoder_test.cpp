@@ -25,7 +25,7 @@
 #include "posefair/drivers/checksums.hpp"
 #include "posefair/drivers/witmotion_decoder.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::witmotion_decoder_test {
 namespace {
 
 using namespace ::posefair::testing;
@@ -556,4 +556,4 @@ TEST(WitMotionDecoder, RandomBytes) {
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::witmotion_decoder_test

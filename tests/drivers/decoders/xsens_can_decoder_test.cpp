@@ -16,7 +16,7 @@
 #include "../../support/can_decoder_testing.hpp"
 #include "posefair/drivers/xsens_can_decoder.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::xsens_can_decoder_test {
 namespace {
 
 using namespace ::posefair::testing;
@@ -217,4 +217,4 @@ TEST(XsensCanDecoder, RandomQuaternionFramesPassTheNormCheckAtTheGeometricRate) 
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::xsens_can_decoder_test

@@ -29,7 +29,7 @@
 #include "posefair/drivers/checksums.hpp"
 #include "posefair/drivers/xsens_decoder.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::xsens_decoder_test {
 namespace {
 
 using namespace ::posefair::testing;
@@ -550,4 +550,4 @@ TEST(XsensDecoder, RandomBytesAcceptedWithinTheChecksumRate) {
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::xsens_decoder_test

@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <limits>
 #include <numbers>
 #include <random>
@@ -24,7 +25,7 @@
 #include "posefair/core/so3.hpp"
 #include "posefair/drivers/yost_decoder.hpp"
 
-namespace posefair::drivers {
+namespace posefair::drivers::yost_decoder_test {
 namespace {
 
 using namespace ::posefair::testing;
@@ -308,7 +309,7 @@ TEST(YostRandom, TenMegabytesOfRandomBytes) {
 }
 
 Bytes file(const std::string& name) {
-  const std::string s = ::posefair::testing::slurp(std::string(POSEFAIR_SOURCE_DIR) + "/tests/fuzz/corpus/yost/" + name);
+  const std::string s = ::posefair::testing::slurp(std::filesystem::path(POSEFAIR_SOURCE_DIR) / "tests/fuzz/corpus/yost" / name);
   return Bytes(s.begin(), s.end());
 }
 
@@ -335,4 +336,4 @@ TEST(YostCorpus, SeedFilesDecodeAsIntended) {
 }
 
 }  // namespace
-}  // namespace posefair::drivers
+}  // namespace posefair::drivers::yost_decoder_test
