@@ -205,7 +205,7 @@ std::optional<Candidate> parse_candidate(const std::string& text) {
     if (pair == "default") continue;
     if (eq == std::string::npos) return std::nullopt;
     const std::string key = pair.substr(0, eq), value = pair.substr(eq + 1);
-    if (key == "publish_on" || key == "wake") {
+    if (key == "fair_on" || key == "publish_on" || key == "wake") {
       c.daemon_keys += key + " = \"" + value + "\"\n";
     } else if (key == "spin_us" || key == "realtime_priority") {
       c.daemon_keys += key + " = " + value + "\n";
@@ -456,7 +456,7 @@ int bench_latency(const LatencyOptions& o) {
     std::optional<Candidate> c = parse_candidate(text);
     if (!c) {
       std::fprintf(stderr, "posefair bench latency: --candidate '%s': expected space-separated key=value pairs of "
-                   "publish_on, spin_us, wake, realtime_priority, cpu_affinity, busy_poll, sendmmsg\n", text.c_str());
+                   "fair_on, publish_on, spin_us, wake, realtime_priority, cpu_affinity, busy_poll, sendmmsg\n", text.c_str());
       return exit_code(ErrorKind::Usage);
     }
     candidates.push_back(std::move(*c));
@@ -505,7 +505,8 @@ void add_bench_latency_command(CLI::App& bench, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
   cmd->add_option("--candidate", o->candidates,
-                  "a configuration to measure, as space-separated key=value pairs: publish_on=engine|publisher, "
+                  "a configuration to measure, as space-separated key=value pairs: fair_on=engine|driver, "
+                  "publish_on=engine|publisher, "
                   "spin_us=N, wake=per-batch|per-sample, realtime_priority=N, cpu_affinity=1[:0...], busy_poll=STREAMS, "
                   "sendmmsg=true|false (\"default\": none); repeat it to compare several")
       ->take_all();

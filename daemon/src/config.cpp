@@ -134,7 +134,7 @@ constexpr std::string_view kSubscriptionKeys[] = {"enabled", "listen", "allow", 
                                                   "rate_per_source", "burst_per_source", "source_table",
                                                   "max_lease", "psk_file"};
 constexpr std::string_view kControlKeys[] = {"enabled", "socket", "mode", "group"};
-constexpr std::string_view kDaemonKeys[] = {"exit_when_sources_end", "session_id", "realtime_priority", "publish_on",
+constexpr std::string_view kDaemonKeys[] = {"exit_when_sources_end", "session_id", "realtime_priority", "publish_on", "fair_on",
                                             "spin_us",               "wake",       "cpu_affinity"};
 constexpr std::string_view kLoggingKeys[] = {"level", "target", "status_interval"};
 constexpr std::string_view kEngineKeys[] = {
@@ -497,6 +497,8 @@ class Parser {
     if (const toml::node* n = t.get("publish_on"))
       d.publish_on = get_choice<PublishThread>(*n, join_key(prefix, "publish_on"),
                                                {{"engine", PublishThread::Engine}, {"publisher", PublishThread::Publisher}});
+    if (const toml::node* n = t.get("fair_on"))
+      d.fair_on = get_choice<FairThread>(*n, join_key(prefix, "fair_on"), {{"engine", FairThread::Engine}, {"driver", FairThread::Driver}});
     if (const toml::node* n = t.get("spin_us")) d.spin_us = static_cast<int>(get_int(*n, join_key(prefix, "spin_us"), 0, 10000));
     if (const toml::node* n = t.get("wake"))
       d.wake_per_batch = get_choice<bool>(*n, join_key(prefix, "wake"), {{"per-batch", true}, {"per-sample", false}});

@@ -169,7 +169,7 @@ struct Pipeline::Stream final : drivers::SampleSink {
     counters.received.fetch_add(1, std::memory_order_relaxed);
     if (record_ring) record_ring->push(r);
     const bool stored = ring.push(r);
-    pipeline.wake_engine();
+    pipeline.handed_over();
     return stored;
   }
 
@@ -192,7 +192,7 @@ struct Pipeline::Stream final : drivers::SampleSink {
   MadeGpioLines gpio;                           // [stream.gpio]: data-ready sink (driver thread), output line
   std::atomic<bool> driver_running{false};
   std::atomic<bool> driver_done{false};
-  bool flushed = false;                         // engine thread only
+  std::atomic<bool> flushed{false};             // written by the engine role's holder only
 };
 
 Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
@@ -308,6 +308,18 @@ std::vector<std::string> Pipeline::start() {
       wake_engine();
     });
   }
+  // With fair_on = "driver" the driver threads do the engine's work: they get its priority.
+  if (const int prio = config_.daemon.realtime_priority; prio > 0 && config_.daemon.fair_on == FairThread::Driver) {
+    sched_param sp{};
+    sp.sched_priority = prio;
+    for (std::jthread& t : driver_threads_) {
+      if (const int rc = ::pthread_setschedparam(t.native_handle(), SCHED_FIFO, &sp); rc != 0) {
+        problems.push_back("realtime_priority " + std::to_string(prio) + " refused for the driver threads (" +
+                           std::strerror(rc) + "): they fair with normal scheduling");
+        break;
+      }
+    }
+  }
   return problems;
 }
 
@@ -420,70 +432,138 @@ void Pipeline::flush_stream(Stream& s) {
   for (int j = 0; j < k; ++j) emit(s, s.outputs[static_cast<std::size_t>(j)], now);
 }
 
+// The engine role's holder (the engine thread, or with [daemon] fair_on = "driver" a driver
+// thread): every stream's ring drained (a bounded batch each), ended streams flushed, the counters
+// stored. True when anything was done.
+bool Pipeline::engine_pass() {
+  heartbeat_.fetch_add(1, std::memory_order_relaxed);
+  bool any = false;
+  for (auto& sp : streams_) {
+    Stream& s = *sp;
+    RingSample r;
+    bool emitted = false;
+    for (int budget = kPopBudget; budget > 0 && s.ring.pop(r); --budget) {
+      any = true;
+      engine_pop_ns_ = monotonic_ns();
+      engine_stage_recorded_ = false;
+      stages_.ring_wait.record(engine_pop_ns_ - r.enqueued_ns);
+      if (hooks_.before_engine_sample) hooks_.before_engine_sample(s.config.id);
+      const Sample sample = unpack(r);
+      // A raw-only sample's quaternion is a placeholder, not a measurement: without a fusion
+      // stage ([stream.fusion]) to make an orientation from its readings it must not reach
+      // the window (the recorder has it already). Counted, and the stream goes on.
+      if (!sample.has_orientation() && !s.fusion) {
+        s.counters.raw_unfused.fetch_add(1, std::memory_order_relaxed);
+        continue;
+      }
+      emitted = fair(s, sample, r.enqueued_ns) || emitted;
+    }
+    // Wake the publisher after each stream's batch (not after the whole pass), so it works
+    // alongside the engine instead of after it.
+    if (emitted && !engine_publishes()) wake_publisher();
+    // The driver has ended and everything it delivered is in: hand over the lagged tail.
+    if (!s.flushed.load(std::memory_order_relaxed) && s.driver_done.load(std::memory_order_acquire) &&
+        s.ring.size_approx() == 0) {
+      flush_stream(s);
+      s.flushed.store(true, std::memory_order_relaxed);
+      any = true;
+    }
+    const GateCounters& g = s.window.gate_counters();
+    const WindowCounters& w = s.window.counters();
+    s.counters.rejected.store(g.rejected(), std::memory_order_relaxed);
+    s.counters.out_of_order.store(g.dropped(), std::memory_order_relaxed);
+    s.counters.emitted.store(w.emitted, std::memory_order_relaxed);
+    s.counters.clamped.store(w.clamped, std::memory_order_relaxed);
+    s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
+    store_engine_state(s.counters, s.window.state());
+    if (s.bridge) {
+      s.counters.bridged_gaps.store(s.bridge->counters().gaps, std::memory_order_relaxed);
+      s.counters.bridged_samples.store(s.bridge->counters().samples, std::memory_order_relaxed);
+    }
+    if (s.fusion) store_fusion_state(s.counters.fusion, s.fusion->state(), s.fusion->waiting());
+    if (s.bridge || s.resampler)
+      s.counters.lerp_fallbacks.store((s.bridge ? s.bridge->counters().lerp_fallbacks : 0) +
+                                          (s.resampler ? s.resampler->lerp_fallbacks() : 0),
+                                      std::memory_order_relaxed);
+  }
+  if (any && !engine_publishes()) wake_publisher();
+  return any;
+}
+
+// fair_on = "driver": the engine role is a flag that one thread at a time holds. Taking and
+// releasing it orders everything the holders touch (windows, histograms, the publisher's
+// sockets) as the engine thread alone would be ordered.
+bool Pipeline::take_engine_role() { return !engine_role_.exchange(true, std::memory_order_acquire); }
+
+void Pipeline::release_engine_role() { engine_role_.store(false, std::memory_order_release); }
+
+// Work a holder must not leave behind when it lets go of the role: a sample in a ring, or a
+// stream whose driver ended and whose window is not flushed yet.
+bool Pipeline::engine_work_pending() const {
+  return std::any_of(streams_.begin(), streams_.end(), [](const auto& s) {
+    return s->ring.size_approx() > 0 ||
+           (s->driver_done.load(std::memory_order_acquire) && !s->flushed.load(std::memory_order_relaxed));
+  });
+}
+
+// fair_on = "driver", on the driver thread that has just handed a sample over: fair and publish
+// it here, with no wake and no second thread, unless another thread holds the engine role. A
+// holder looks once more for work after letting go (a Dekker pair with the hand-over: the ring's
+// push, a full fence, the take; the holder's release, a full fence, the look), so a sample that
+// found the role taken is never left behind.
+void Pipeline::fair_here() {
+  std::atomic_thread_fence(std::memory_order_seq_cst);
+  for (int round = 1; take_engine_role(); ++round) {
+    if (hooks_.on_engine_role) hooks_.on_engine_role(true);
+    engine_pass();
+    if (hooks_.on_engine_role) hooks_.on_engine_role(false);
+    release_engine_role();
+    std::atomic_thread_fence(std::memory_order_seq_cst);
+    if (!engine_work_pending()) return;
+    // A driver thread must get back to its device: after a few passes for the other streams'
+    // samples it leaves the rest to the engine thread.
+    if (round == kDriverPasses) {
+      wake_engine();
+      return;
+    }
+  }
+}
+
+void Pipeline::handed_over() {
+  if (config_.daemon.fair_on == FairThread::Driver)
+    fair_here();
+  else
+    wake_engine();
+}
+
 void Pipeline::engine_loop() {
   ::pthread_setname_np(::pthread_self(), "pf-engine");  // for top -H, perf and gdb
   if (hooks_.on_realtime_thread_start) hooks_.on_realtime_thread_start();
+  const bool shared = config_.daemon.fair_on == FairThread::Driver;
   for (;;) {
     const std::uint32_t seen = engine_wake_.prepare();
-    heartbeat_.fetch_add(1, std::memory_order_relaxed);
     bool any = false;
-    for (auto& sp : streams_) {
-      Stream& s = *sp;
-      RingSample r;
-      bool emitted = false;
-      for (int budget = kPopBudget; budget > 0 && s.ring.pop(r); --budget) {
-        any = true;
-        engine_pop_ns_ = monotonic_ns();
-        engine_stage_recorded_ = false;
-        stages_.ring_wait.record(engine_pop_ns_ - r.enqueued_ns);
-        if (hooks_.before_engine_sample) hooks_.before_engine_sample(s.config.id);
-        const Sample sample = unpack(r);
-        // A raw-only sample's quaternion is a placeholder, not a measurement: without a fusion
-        // stage ([stream.fusion]) to make an orientation from its readings it must not reach
-        // the window (the recorder has it already). Counted, and the stream goes on.
-        if (!sample.has_orientation() && !s.fusion) {
-          s.counters.raw_unfused.fetch_add(1, std::memory_order_relaxed);
-          continue;
-        }
-        emitted = fair(s, sample, r.enqueued_ns) || emitted;
-      }
-      // Wake the publisher after each stream's batch (not after the whole pass), so it works
-      // alongside the engine instead of after it.
-      if (emitted && !engine_publishes()) wake_publisher();
-      // The driver has ended and everything it delivered is in: hand over the lagged tail.
-      if (!s.flushed && s.driver_done.load(std::memory_order_acquire) && s.ring.size_approx() == 0) {
-        flush_stream(s);
-        s.flushed = true;
-        any = true;
-      }
-      const GateCounters& g = s.window.gate_counters();
-      const WindowCounters& w = s.window.counters();
-      s.counters.rejected.store(g.rejected(), std::memory_order_relaxed);
-      s.counters.out_of_order.store(g.dropped(), std::memory_order_relaxed);
-      s.counters.emitted.store(w.emitted, std::memory_order_relaxed);
-      s.counters.clamped.store(w.clamped, std::memory_order_relaxed);
-      s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
-      store_engine_state(s.counters, s.window.state());
-      if (s.bridge) {
-        s.counters.bridged_gaps.store(s.bridge->counters().gaps, std::memory_order_relaxed);
-        s.counters.bridged_samples.store(s.bridge->counters().samples, std::memory_order_relaxed);
-      }
-      if (s.fusion) store_fusion_state(s.counters.fusion, s.fusion->state(), s.fusion->waiting());
-      if (s.bridge || s.resampler)
-        s.counters.lerp_fallbacks.store((s.bridge ? s.bridge->counters().lerp_fallbacks : 0) +
-                                            (s.resampler ? s.resampler->lerp_fallbacks() : 0),
-                                        std::memory_order_relaxed);
+    if (!shared) {
+      any = engine_pass();
+    } else if (take_engine_role()) {
+      // With fair_on = "driver" this thread fairs what no driver thread did: a stream's end,
+      // the drain at stop, a watchdog poke; the drivers do the rest.
+      any = engine_pass();
+      release_engine_role();
+      std::atomic_thread_fence(std::memory_order_seq_cst);
+      if (!any && engine_work_pending()) continue;
     }
-    if (any) {
-      if (!engine_publishes()) wake_publisher();
-      continue;
-    }
+    if (any) continue;
     if (engine_stop_.load(std::memory_order_acquire)) return;
     if (busy_polling()) {  // a busy_poll stream runs: look again at once, never park
       cpu_relax();
       continue;
     }
-    engine_wake_.wait(seen, engine_spin_);
+    // Nothing hands samples to this thread with fair_on = "driver": no spin for them.
+    if (shared)
+      engine_wake_.wait(seen);
+    else
+      engine_wake_.wait(seen, engine_spin_);
   }
 }
 

@@ -310,11 +310,12 @@ TEST(Config, AFullConfigFillsEveryField) {
   EXPECT_EQ(loaded.recorder.path, dir.path() / "rec" / "out.pflog");
 }
 
-// [daemon] publish_on, spin_us, wake, cpu_affinity; [[stream]] busy_poll; [[output]] sendmmsg
-// (docs/config.md; measured in docs/benchmarks.md, "Latency by stage").
+// [daemon] fair_on, publish_on, spin_us, wake, cpu_affinity; [[stream]] busy_poll; [[output]]
+// sendmmsg (docs/config.md; measured in docs/benchmarks.md, "Latency by stage").
 TEST(Config, TheLatencyKeysChooseHowTheThreadsHandOver) {
   const DaemonConfig c = parse_config(R"toml(
 [daemon]
+fair_on = "engine"
 publish_on = "publisher"
 spin_us = 40
 wake = "per-sample"
@@ -333,6 +334,7 @@ destinations = ["127.0.0.1:5700", "127.0.0.1:5701"]
 sendmmsg = false
 )toml",
                                       "/nonexistent/latency.toml");
+  EXPECT_EQ(c.daemon.fair_on, FairThread::Engine);
   EXPECT_EQ(c.daemon.publish_on, PublishThread::Publisher);
   EXPECT_EQ(c.daemon.spin_us, 40);
   EXPECT_FALSE(c.daemon.wake_per_batch);
@@ -347,6 +349,7 @@ sendmmsg = false
                                       "[[output]]\ndestinations = [\"127.0.0.1:5700\"]\n",
                                       "/nonexistent/defaults.toml");
   const DaemonSettings defaults;
+  EXPECT_EQ(d.daemon.fair_on, FairThread::Driver);
   EXPECT_EQ(d.daemon.publish_on, defaults.publish_on);
   EXPECT_EQ(d.daemon.spin_us, defaults.spin_us);
   EXPECT_TRUE(d.daemon.wake_per_batch);
@@ -2096,6 +2099,13 @@ id = 1
 name = "a"
 driver = { type = "replay", candump = "bus.log", protocol = "xsens-can", fd = true }
 )", "stream[1].driver.fd: unknown key for driver type replay (it belongs to type socketcan)", 4},
+    {"fair_on: not a thread that fairs", R"([daemon]
+fair_on = "publisher"
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic" }
+)", "daemon.fair_on", 2},
     {"publish_on: not a thread", R"([daemon]
 publish_on = "driver"
 [[stream]]

@@ -98,10 +98,21 @@ PipelineRun run_pipeline(const std::string& driver, const std::string& solver, c
   UdpCollector receiver;  // the output's destination; its thread claims no counter slot
   const DaemonConfig config =
       parse_config(config_text(receiver.port(), driver, solver, encoding, daemon_keys), "/virtual/pipeline-alloc.toml");
-  run.expected_threads = config.daemon.publish_on == PublishThread::Engine ? 1 : 2;
+  // The engine thread, the publisher's unless the engine publishes, and with fair_on = "driver"
+  // the stream's driver thread while it fairs.
+  run.expected_threads = (config.daemon.publish_on == PublishThread::Engine ? 1 : 2) +
+                         (config.daemon.fair_on == FairThread::Driver ? 1 : 0);
   PipelineHooks hooks;
   // Stateless, so calling it allocates nothing; claiming a slot does not allocate either.
   hooks.on_realtime_thread_start = [] { counting::claim_counter_slot(); };
+  hooks.on_engine_role = [](bool held) {
+    if (!held)
+      counting::suspend_counter_slot();
+    else if (counting::has_counter_slot())
+      counting::resume_counter_slot();
+    else
+      counting::claim_counter_slot();
+  };
   {
     Pipeline pipeline(config, kSession, {}, false, hooks, subscribers);
     pipeline.start();
@@ -177,12 +188,13 @@ TEST_F(PipelineAllocation, ReplayToABinaryOutputAllocatesNothingOnTheRealtimeThr
   EXPECT_GT(run.datagrams, 0u);
 }
 
-// Each way of handing over ([daemon] publish_on, spin_us, wake; docs/config.md) allocates
+// Each way of handing over ([daemon] fair_on, publish_on, spin_us, wake; docs/config.md) allocates
 // nothing either: the spin, the batched wake and publishing from the engine thread are all
 // plain loads, stores and system calls.
 TEST_F(PipelineAllocation, EveryHandOverOptionAllocatesNothingOnTheRealtimeThreads) {
   for (const char* keys : {"publish_on = \"engine\"\nspin_us = 100\n", "publish_on = \"publisher\"\nspin_us = 100\n",
-                           "publish_on = \"publisher\"\nwake = \"per-sample\"\n"}) {
+                           "publish_on = \"publisher\"\nwake = \"per-sample\"\n", "fair_on = \"engine\"\n",
+                           "fair_on = \"driver\"\npublish_on = \"publisher\"\n"}) {
     SCOPED_TRACE(keys);
     counting::release_counter_slots();
     const PipelineRun run = run_pipeline(replay_driver(), "linear", "binary", nullptr, keys);

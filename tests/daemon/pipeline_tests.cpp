@@ -109,12 +109,20 @@ struct SlowRun {
   std::size_t malformed = 0;
 };
 
+// The engine thread as the slow consumer the next tests need: with the default fair_on =
+// "driver" a slow fairing would slow the replay's own thread instead, and the ring never fills.
+std::string engine_thread_fairs(std::string config) {
+  const std::string daemon = "[daemon]\n";
+  config.insert(config.find(daemon) + daemon.size(), "fair_on = \"engine\"\n");
+  return config;
+}
+
 // Replays the demo recording into a ring of 8 with an engine that sleeps ~200 µs before every
 // sample, then stops the pipeline and collects what arrived.
 SlowRun run_slow_consumer(const std::string& overflow) {
   SlowRun run;
   UdpCollector receiver;
-  const DaemonConfig config = parse_config(replay_config(receiver.port(), 8, overflow), "/virtual/slow.toml");
+  const DaemonConfig config = parse_config(engine_thread_fairs(replay_config(receiver.port(), 8, overflow)), "/virtual/slow.toml");
   std::atomic<std::uint64_t> calls{0};
   PipelineHooks hooks;
   hooks.before_engine_sample = [&calls](std::uint32_t stream_id) {
@@ -269,7 +277,8 @@ TEST(Pipeline, SlowConsumerDropNewestCountsEveryDropAndKeepsTheOldest) {
 TEST(Pipeline, EveryPoseOfALongEnginePassIsPublished) {
   UdpCollector receiver;
   const DaemonConfig config = parse_config(
-      replay_config(receiver.port(), 8, "drop-oldest", "timing = \"original\"\nspeed = 35.0\n"), "/virtual/pass.toml");
+      engine_thread_fairs(replay_config(receiver.port(), 8, "drop-oldest", "timing = \"original\"\nspeed = 35.0\n")),
+      "/virtual/pass.toml");
   PipelineHooks hooks;
   hooks.before_engine_sample = [](std::uint32_t) { std::this_thread::sleep_for(200us); };
   StreamStats s;
@@ -619,7 +628,7 @@ TEST(Pipeline, OrientationWithAGyroIsFairedWithTheGyroAndItsEstimatesAreReported
   EXPECT_LT(aided, 0.5 * alone) << "gyro-aided " << aided << "°, alone " << alone << "°";
 }
 
-// The hand-over options ([daemon] publish_on, spin_us, wake, cpu_affinity; [[stream]] busy_poll;
+// The hand-over options ([daemon] fair_on, publish_on, spin_us, wake, cpu_affinity; [[stream]] busy_poll;
 // [[output]] sendmmsg; docs/config.md): whichever is chosen, three replayed streams to an output
 // with two destinations are published exactly once each, in order per stream, every counter adds
 // up, and every stage of the latency histograms saw every sample (the hand-off only when a
@@ -698,7 +707,12 @@ INSTANTIATE_TEST_SUITE_P(
                                       "publish_on = \"publisher\"\nspin_us = 200\nwake = \"per-sample\"\n", "", "", false},
                       HandOverOptions{"BusyPoll", "publish_on = \"engine\"\n", "busy_poll = true\n", "", true},
                       HandOverOptions{"PinnedToCpu0", "publish_on = \"publisher\"\ncpu_affinity = [0]\n", "", "", false},
-                      HandOverOptions{"SendtoEachDestination", "publish_on = \"engine\"\n", "", "sendmmsg = false\n", true}),
+                      HandOverOptions{"SendtoEachDestination", "publish_on = \"engine\"\n", "", "sendmmsg = false\n", true},
+                      HandOverOptions{"DriversFairAndPublish", "fair_on = \"driver\"\npublish_on = \"engine\"\n", "", "", true},
+                      HandOverOptions{"DriversFairForAPublisherThread", "fair_on = \"driver\"\npublish_on = \"publisher\"\n",
+                                      "", "", false},
+                      HandOverOptions{"DriversFairWhileTheEngineBusyPolls", "fair_on = \"driver\"\n", "busy_poll = true\n", "",
+                                      true}),
     [](const ::testing::TestParamInfo<HandOverOptions>& i) { return std::string(i.param.name); });
 
 }  // namespace

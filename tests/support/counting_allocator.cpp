@@ -22,6 +22,7 @@ void* volatile g_sink = nullptr;  // pointers escape here so test allocations ca
 // initialiser and never allocates.
 constinit thread_local std::size_t t_allocations = 0;
 constinit thread_local std::atomic<std::size_t>* t_slot = nullptr;
+constinit thread_local std::atomic<std::size_t>* t_suspended_slot = nullptr;
 
 // Static storage: a slot outlives the thread that counts into it.
 std::array<std::atomic<std::size_t>, posefair::testing::kCounterSlots> g_slots{};
@@ -107,6 +108,18 @@ int claim_counter_slot() {
   return slot;
 }
 
+void suspend_counter_slot() {
+  if (t_slot) t_suspended_slot = t_slot;
+  t_slot = nullptr;
+}
+
+void resume_counter_slot() {
+  if (t_suspended_slot) t_slot = t_suspended_slot;
+  t_suspended_slot = nullptr;
+}
+
+bool has_counter_slot() { return t_slot != nullptr || t_suspended_slot != nullptr; }
+
 int counter_slots_claimed() {
   const int n = g_slots_claimed.load(std::memory_order_relaxed);
   return n < kCounterSlots ? n : kCounterSlots;
@@ -119,6 +132,7 @@ std::size_t slot_allocations(int slot) {
 
 void release_counter_slots() {
   t_slot = nullptr;
+  t_suspended_slot = nullptr;
   for (std::atomic<std::size_t>& s : g_slots) s.store(0, std::memory_order_relaxed);
   g_slots_claimed.store(0, std::memory_order_relaxed);
 }

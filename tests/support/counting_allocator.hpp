@@ -22,6 +22,12 @@ inline constexpr int kCounterSlots = 16;
 // Claims the next free slot for the calling thread: from now on each of its allocations is
 // also counted there. Does not allocate. Returns the slot, or -1 if all are taken.
 int claim_counter_slot();
+// Stops counting the calling thread's allocations into its slot, or counts them there again:
+// for a thread that is real-time only for part of its work (a driver thread while it fairs).
+void suspend_counter_slot();
+void resume_counter_slot();
+// Whether the calling thread has claimed a slot (suspended or not).
+bool has_counter_slot();
 // How many slots are claimed (at most kCounterSlots).
 int counter_slots_claimed();
 // Allocations counted in `slot` (0 for a slot out of range or not claimed).

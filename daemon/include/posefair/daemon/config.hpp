@@ -63,6 +63,7 @@ struct LoggingConfig {
 };
 
 enum class PublishThread { Publisher, Engine };
+enum class FairThread { Engine, Driver };
 
 struct DaemonSettings {
   // Exit (status 0) once every driver has ended and every pose is out, e.g. a replay without
@@ -79,6 +80,9 @@ struct DaemonSettings {
   // which thread sends the faired poses: a publisher thread of its own, or the engine thread
   // right after fairing (no second hop).
   PublishThread publish_on = PublishThread::Engine;
+  // which thread fairs the samples: the engine thread, woken by the drivers, or the driver
+  // thread that handed the sample over, while no other thread is fairing (no wake at all).
+  FairThread fair_on = FairThread::Driver;
   // Bounded adaptive spin (µs) of the engine and publisher threads before they park; 0: park at once.
   int spin_us = 50;
   // One FUTEX_WAKE per sleep of the woken thread (true), or one per notify while it sleeps.
