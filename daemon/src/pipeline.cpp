@@ -492,10 +492,15 @@ bool Pipeline::engine_pass() {
 
 // fair_on = "driver": the engine role is a flag that one thread at a time holds. Taking and
 // releasing it orders everything the holders touch (windows, histograms, the publisher's
-// sockets) as the engine thread alone would be ordered.
-bool Pipeline::take_engine_role() { return !engine_role_.exchange(true, std::memory_order_acquire); }
+// sockets) as the engine thread alone would be ordered. Both are exchanges (read-modify-write,
+// acquire and release): a hand-over that finds the role taken still writes the flag after its
+// push into the ring, so the holder's releasing exchange reads that write and sees the push, and
+// its look for work afterwards finds the sample. Either the hand-over takes the role, or the
+// holder sees its sample: none is left behind (and ThreadSanitizer can follow it, which it
+// cannot with fences).
+bool Pipeline::take_engine_role() { return !engine_role_.exchange(true, std::memory_order_acq_rel); }
 
-void Pipeline::release_engine_role() { engine_role_.store(false, std::memory_order_release); }
+void Pipeline::release_engine_role() { engine_role_.exchange(false, std::memory_order_acq_rel); }
 
 // Work a holder must not leave behind when it lets go of the role: a sample in a ring, or a
 // stream whose driver ended and whose window is not flushed yet.
@@ -507,18 +512,14 @@ bool Pipeline::engine_work_pending() const {
 }
 
 // fair_on = "driver", on the driver thread that has just handed a sample over: fair and publish
-// it here, with no wake and no second thread, unless another thread holds the engine role. A
-// holder looks once more for work after letting go (a Dekker pair with the hand-over: the ring's
-// push, a full fence, the take; the holder's release, a full fence, the look), so a sample that
-// found the role taken is never left behind.
+// it here, with no wake and no second thread, unless another thread holds the engine role (which
+// then takes the sample: see take_engine_role).
 void Pipeline::fair_here() {
-  std::atomic_thread_fence(std::memory_order_seq_cst);
   for (int round = 1; take_engine_role(); ++round) {
     if (hooks_.on_engine_role) hooks_.on_engine_role(true);
     engine_pass();
     if (hooks_.on_engine_role) hooks_.on_engine_role(false);
     release_engine_role();
-    std::atomic_thread_fence(std::memory_order_seq_cst);
     if (!engine_work_pending()) return;
     // A driver thread must get back to its device: after a few passes for the other streams'
     // samples it leaves the rest to the engine thread.
@@ -550,7 +551,6 @@ void Pipeline::engine_loop() {
       // the drain at stop, a watchdog poke; the drivers do the rest.
       any = engine_pass();
       release_engine_role();
-      std::atomic_thread_fence(std::memory_order_seq_cst);
       if (!any && engine_work_pending()) continue;
     }
     if (any) continue;
