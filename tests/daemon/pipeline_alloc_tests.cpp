@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <utility>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -90,14 +91,13 @@ struct PipelineRun {
   std::uint64_t datagrams = 0;
 };
 
-// Runs the pipeline until its source ends, stops it (which joins the engine and publisher
-// threads) and reads what each real-time thread allocated.
-PipelineRun run_pipeline(const std::string& driver, const std::string& solver, const std::string& encoding,
-                         std::shared_ptr<SubscriberTable> subscribers = nullptr, const std::string& daemon_keys = "") {
+// Runs the pipeline of config_text(port) until its sources end, stops it (which joins the
+// engine and publisher threads) and reads what each real-time thread allocated.
+PipelineRun run_config(const std::function<std::string(std::uint16_t port)>& config_text,
+                       std::shared_ptr<SubscriberTable> subscribers = nullptr) {
   PipelineRun run;
   UdpCollector receiver;  // the output's destination; its thread claims no counter slot
-  const DaemonConfig config =
-      parse_config(config_text(receiver.port(), driver, solver, encoding, daemon_keys), "/virtual/pipeline-alloc.toml");
+  const DaemonConfig config = parse_config(config_text(receiver.port()), "/virtual/pipeline-alloc.toml");
   run.expected_threads = config.daemon.publish_on == PublishThread::Engine ? 1 : 2;
   PipelineHooks hooks;
   // Stateless, so calling it allocates nothing; claiming a slot does not allocate either.
@@ -117,15 +117,23 @@ PipelineRun run_pipeline(const std::string& driver, const std::string& solver, c
   return run;
 }
 
+// One stream (config_text above) to one output.
+PipelineRun run_pipeline(const std::string& driver, const std::string& solver, const std::string& encoding,
+                         std::shared_ptr<SubscriberTable> subscribers = nullptr, const std::string& daemon_keys = "") {
+  return run_config([&](std::uint16_t port) { return config_text(port, driver, solver, encoding, daemon_keys); },
+                    std::move(subscribers));
+}
+
 // Writes samples (stream 1) to a sample log at path; the replay driver's table body for it.
-std::string replay_of(const std::filesystem::path& path, const std::vector<Sample>& samples) {
+std::string replay_of(const std::filesystem::path& path, const std::vector<Sample>& samples,
+                      const std::string& timing = "timing = \"fast\"\n") {
   formats::SampleLogHeader h;
   h.streams = {{1, "imu", "test"}};
   formats::SampleLogWriterOptions o;
   o.sync = false;
   formats::SampleLogWriter w(path, h, o);
   for (const Sample& s : samples) w.append(s);
-  return "type = \"replay\"\npath = \"" + path.string() + "\"\ntiming = \"fast\"\n";
+  return "type = \"replay\"\npath = \"" + path.string() + "\"\n" + timing;
 }
 
 std::string describe(const PipelineRun& run) {
@@ -236,6 +244,40 @@ TEST_F(PipelineAllocation, GyroAidedFairingAllocatesNothingOnTheRealtimeThreads)
   EXPECT_EQ(run.stats.published, 1000u);
   EXPECT_TRUE(run.stats.engine.gyro.active);
   EXPECT_GT(run.stats.engine.gyro.intervals, 900u);
+}
+
+// An orientation stream faired with the gyroscope of another stream ([stream.engine]
+// gyro_stream): the IMU's readings kept for the pairing and matched to each sample, on the
+// engine thread, allocate nothing either. Replayed in real time (4x), the IMU's readings
+// beginning 30 ms after the tracker's samples so that they lead them, and are matched.
+TEST_F(PipelineAllocation, AGyroFromAnotherStreamAllocatesNothingOnTheRealtimeThreads) {
+  posefair::testing::ScratchDir dir;
+  posefair::testing::GyroTrackerSpec optical;
+  optical.rate_hz = 120.0;
+  optical.seconds = 2.0;
+  std::vector<Sample> tracker = posefair::testing::make_gyro_tracker_stream(optical).samples;
+  for (Sample& x : tracker) x.flags &= ~static_cast<std::uint32_t>(kHasGyro);
+  posefair::testing::GyroTrackerSpec imu;
+  imu.rate_hz = 1000.0;
+  imu.start_time = 0.03;
+  imu.seconds = optical.seconds - imu.start_time;
+  imu.offset = 0.003;
+  const std::string real_time = "speed = 4.0\n";
+  const std::string tracker_driver = replay_of(dir / "optical.pflog", tracker, real_time);
+  const std::string imu_driver = replay_of(dir / "imu.pflog", posefair::testing::make_imu_readings(imu), real_time);
+  const PipelineRun run = run_config([&](std::uint16_t port) {
+    return "[[stream]]\nid = 1\nname = \"optical\"\nring_capacity = 4096\n[stream.driver]\n" + tracker_driver +
+           "[stream.engine]\ngyro_stream = \"imu\"\n[[stream]]\nid = 2\nname = \"imu\"\nring_capacity = 4096\n"
+           "[stream.driver]\n" + imu_driver + "[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(port) + "\"]\n";
+  });
+  SCOPED_TRACE(describe(run));
+  EXPECT_TRUE(run.ended);
+  ASSERT_EQ(run.threads, run.expected_threads);
+  for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
+  EXPECT_EQ(run.stats.published, tracker.size());
+  ASSERT_TRUE(run.stats.gyro_pairing);
+  EXPECT_GT(run.stats.gyro_pairing->matched, tracker.size() / 2);
+  EXPECT_GT(run.stats.engine.gyro.intervals, 0u);
 }
 
 TEST_F(PipelineAllocation, GaussNewtonOnASyntheticStreamAllocatesNothingOnTheRealtimeThreads) {
