@@ -23,8 +23,18 @@ void GyroPairing::apply(Sample& s) {
   // A repeated or older time (the engine's gate drops the sample) or a non-finite one (it
   // rejects it) is no interval.
   if (!std::isfinite(t) || (!std::isnan(last_time_) && !(t > last_time_))) return;
-  const double from = last_time_;
+  double from = last_time_;
   last_time_ = t;
+  // After a gap (an interval over twice the one before) the mean over the whole gap is no rate
+  // at t: the sample takes one interval of the old length, and the line starts again.
+  if (last_interval_ > 0.0 && t - from > 2.0 * last_interval_) {
+    const double interval = t - from;
+    from = t - last_interval_;
+    last_interval_ = interval;
+    have_previous_ = false;
+  } else if (!std::isnan(from)) {
+    last_interval_ = t - from;
+  }
   std::size_t n = 0;
   Vec3 sum = Vec3::Zero();
   double time_sum = 0.0;

@@ -1,7 +1,8 @@
 // [stream.engine] gyro_stream's matcher (daemon/…/gyro_pairing.hpp): each orientation sample
 // gets the source's rate at its own time from the readings of its interval, exactly for a rate
 // that changes linearly whatever the spacing of either stream; no reading in the interval is no
-// match; readings past the sample wait for the next interval; bad readings are left out.
+// match; readings past the sample wait for the next interval; bad readings are left out; a gap
+// is not averaged over.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -100,6 +101,19 @@ TEST(GyroPairing, NonFiniteAndOutOfOrderReadingsAndRepeatedSamplesAreLeftOut) {
   pairing.apply(repeated);
   EXPECT_FALSE(repeated.has_gyro());
   EXPECT_EQ(pairing.matched() + pairing.unmatched(), 2u);
+}
+
+TEST(GyroPairing, AfterAGapOnlyTheLastIntervalOfTheOldLengthIsAveraged) {
+  GyroPairing pairing;
+  for (int i = 1; i <= 100; ++i) pairing.add(0.001 * i, Vec3(i < 90 ? 9.0 : 1.0, 0, 0));
+  for (double t : {0.0, 0.010}) {
+    Sample s = orientation_at(t);
+    pairing.apply(s);
+  }
+  Sample after_gap = orientation_at(0.100);  // 90 ms after the last sample, whose interval was 10 ms
+  pairing.apply(after_gap);
+  ASSERT_TRUE(after_gap.has_gyro());
+  EXPECT_DOUBLE_EQ(after_gap.gyro.x(), 1.0) << "the readings of (0.090, 0.100] alone, and no line through the old mean";
 }
 
 TEST(GyroPairing, OnlyTheNewestReadingsAreKept) {

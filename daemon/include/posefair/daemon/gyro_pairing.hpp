@@ -15,8 +15,10 @@
 // ω(t) = m + (m − m')·(t − c)/(c − c'), at most one interval ahead (exact for a rate that
 // changes linearly; on white noise it costs 1.6× the mean's noise, still far below one reading's
 // at 8 readings per interval). No reading in the interval: no match, and the sample goes on
-// without a gyro (the engine's no-gyro path). The IMU's readings are in its own frame: the
-// engine's gyro_mounting, bias and time offset apply as to a gyro in the sample itself.
+// without a gyro (the engine's no-gyro path). After a gap in the orientation stream (an interval
+// over twice the one before) only the last interval of the old length is averaged. The IMU's
+// readings are in its own frame: the engine's gyro_mounting, bias and time offset apply as to a
+// gyro in the sample itself.
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -52,6 +54,7 @@ class GyroPairing {
   std::vector<Reading> ring_;  // kCapacity entries, the newest at next_ - 1
   std::size_t next_ = 0, count_ = 0;
   double last_time_ = std::numeric_limits<double>::quiet_NaN();  // the previous orientation sample's time
+  double last_interval_ = 0.0;  // t − t_prev of the previous sample; 0 before the second sample
   bool have_previous_ = false;  // the previous interval matched: (previous_time_, previous_mean_) is its (c', m')
   double previous_time_ = 0.0;
   Vec3 previous_mean_ = Vec3::Zero();
