@@ -675,7 +675,7 @@ fusion = { tau_acc = 4 }
 // [stream.engine] gyro_stream names another stream; the pair keeps the stream's gyro keys, and
 // a source with a fusion stage (a raw IMU) keeps its own gyro aiding off.
 TEST(Config, AGyroStreamNamesAnotherStreamOnTheBody) {
-  testing::ScratchDir dir("posefair-config-");
+  posefair::testing::ScratchDir dir("posefair-config-");
   write_file(dir / "optical.tum", "0 0 0 0 0 0 0 1\n");
   const DaemonConfig c = parse_config(R"toml(
 [[stream]]
