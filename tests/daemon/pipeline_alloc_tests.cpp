@@ -249,7 +249,7 @@ TEST_F(PipelineAllocation, GyroAidedFairingAllocatesNothingOnTheRealtimeThreads)
 // An orientation stream faired with the gyroscope of another stream ([stream.engine]
 // gyro_stream): the IMU's readings kept for the pairing and matched to each sample, on the
 // engine thread, allocate nothing either. Replayed in real time (4x), the IMU's readings
-// beginning 30 ms after the tracker's samples so that they lead them, and are matched.
+// beginning 0.1 s after the tracker's samples so that they lead them, and are matched.
 TEST_F(PipelineAllocation, AGyroFromAnotherStreamAllocatesNothingOnTheRealtimeThreads) {
   posefair::testing::ScratchDir dir;
   posefair::testing::GyroTrackerSpec optical;
@@ -259,7 +259,7 @@ TEST_F(PipelineAllocation, AGyroFromAnotherStreamAllocatesNothingOnTheRealtimeTh
   for (Sample& x : tracker) x.flags &= ~static_cast<std::uint32_t>(kHasGyro);
   posefair::testing::GyroTrackerSpec imu;
   imu.rate_hz = 1000.0;
-  imu.start_time = 0.03;
+  imu.start_time = 0.1;
   imu.seconds = optical.seconds - imu.start_time;
   imu.offset = 0.003;
   const std::string real_time = "speed = 4.0\n";

@@ -625,9 +625,11 @@ TEST(Pipeline, OrientationWithAGyroIsFairedWithTheGyroAndItsEstimatesAreReported
 // their own sample logs in real time (4x): the optical stream's engine gets the IMU's rate for
 // each of its samples ([stream.engine] gyro_stream), finds the time offset, and its error
 // against the true motion is far below that of the same optical stream faired alone (a third
-// stream). The IMU starts 30 ms after the tracker (its readings then lead the tracker's samples,
-// as an IMU's do behind an optical system's latency); the tracker's first samples have no
-// readings and are counted unmatched. The counter line and STATUS= name the source.
+// stream). The IMU starts 0.2 s after the tracker, so that in real time its readings lead the
+// tracker's samples by 50 ms, as an IMU's do behind an optical system's latency, and a replay
+// thread held up that long on a loaded machine still delivers in time; the tracker's first 24
+// samples have no readings and are counted unmatched. The counter line and STATUS= name the
+// source.
 TEST(Pipeline, AGyroFromAnotherStreamOnTheBodyIsMatchedToEachSampleAndFairsItWithoutLag) {
   ScratchDir dir;
   posefair::testing::GyroTrackerSpec optical;
@@ -638,7 +640,7 @@ TEST(Pipeline, AGyroFromAnotherStreamOnTheBodyIsMatchedToEachSampleAndFairsItWit
   for (Sample& x : tracker.samples) x.flags &= ~static_cast<std::uint32_t>(kHasGyro);  // an orientation alone
   posefair::testing::GyroTrackerSpec imu;
   imu.rate_hz = 1000.0;
-  imu.start_time = 0.03;
+  imu.start_time = 0.2;
   imu.seconds = optical.seconds - imu.start_time;
   imu.offset = 0.004;
   imu.mounting = rotation_from_zyx_degrees(90.0, 0.0, 30.0);
@@ -668,8 +670,8 @@ TEST(Pipeline, AGyroFromAnotherStreamOnTheBodyIsMatchedToEachSampleAndFairsItWit
   ASSERT_TRUE(paired.gyro_pairing);
   EXPECT_EQ(paired.gyro_pairing->source, "imu");
   EXPECT_EQ(paired.gyro_pairing->matched + paired.gyro_pairing->unmatched, n);
-  EXPECT_GE(paired.gyro_pairing->unmatched, 1u) << "the samples before the IMU's first reading";
-  EXPECT_GT(paired.gyro_pairing->matched, n - n / 50) << "the IMU's readings reach nearly every sample";
+  EXPECT_GE(paired.gyro_pairing->unmatched, 24u) << "the samples before the IMU's first reading";
+  EXPECT_GT(paired.gyro_pairing->matched, n - 24 - n / 100) << "the IMU's readings reach nearly every later sample";
   EXPECT_TRUE(paired.engine.gyro.active);
   EXPECT_TRUE(paired.engine.gyro.offset_estimated);
   EXPECT_NEAR(paired.engine.gyro.time_offset_s, imu.offset, 0.001);
