@@ -141,7 +141,7 @@ constexpr std::string_view kEngineKeys[] = {
     "window",   "window_time", "max_window", "lag", "horizon", "order", "solver", "iterations", "smoothing", "smoothing_r",
     "smoothing_t", "cutoff_hz", "rate_hz", "continuity", "lambda_r", "lambda_t", "variant",
     "epsilon_r", "epsilon_t", "bound",  "gap",       "gap_intervals", "unit_tolerance", "gyro_aided", "gyro_time_offset",
-    "gyro_estimate_offset", "gyro_mounting"};
+    "gyro_estimate_offset", "gyro_mounting", "gyro_stream"};
 constexpr std::string_view kStreamKeys[] = {"id",     "name", "ring_capacity", "overflow", "driver", "engine",
                                             "spline", "gpio", "fusion",        "mounting", "world",  "busy_poll"};
 constexpr std::string_view kGpioKeys[] = {"chip",          "data_ready_line", "edge",        "bias",         "tolerance_min",
@@ -332,6 +332,7 @@ struct EngineLayer {
   std::optional<Given<bool>> gyro_aided, gyro_estimate_offset;
   std::optional<Given<double>> gyro_time_offset;
   std::optional<Given<Quat>> gyro_mounting;
+  std::optional<Given<std::string>> gyro_stream;  // [stream.engine] only: the stream whose gyroscope this one gets
 };
 
 class Parser {
@@ -351,9 +352,11 @@ class Parser {
     if (streams == nullptr) fail(toml::source_position{}, "stream", "missing required key: at least one [[stream]] table is needed");
     const toml::array& stream_array = array_of_tables(*streams, "stream", "[[stream]]");
     if (stream_array.empty()) fail(*streams, "stream", "at least one [[stream]] table is required");
+    std::vector<std::optional<Where>> gyro_streams;  // where each stream's gyro_stream was given
     for (std::size_t i = 0; i < stream_array.size(); ++i) {
-      config.streams.push_back(parse_stream(stream_array[i], element_key("stream", i), global, config.streams));
+      config.streams.push_back(parse_stream(stream_array[i], element_key("stream", i), global, config.streams, gyro_streams.emplace_back()));
     }
+    check_gyro_streams(config.streams, gyro_streams);
 
     if (const toml::node* n = root.get("output")) {
       const toml::array& outputs = array_of_tables(*n, "output", "[[output]]");
@@ -607,6 +610,11 @@ class Parser {
     if (const toml::node* n = t.get("gyro_mounting")) {
       const std::string key = join_key(prefix, "gyro_mounting");
       e.gyro_mounting = Given<Quat>{get_rotation(*n, key), where(*n, key)};
+    }
+    if (const toml::node* n = t.get("gyro_stream")) {
+      const std::string key = join_key(prefix, "gyro_stream");
+      if (prefix == "engine") fail(*n, key, "only in [stream.engine]: it names the one stream whose gyroscope that stream gets");
+      e.gyro_stream = Given<std::string>{get_nonempty_string(*n, key), where(*n, key)};
     }
 
     if (e.cutoff_hz) {
@@ -1173,7 +1181,7 @@ class Parser {
   }
 
   StreamConfig parse_stream(const toml::node& node, const std::string& prefix, const EngineLayer& global,
-                            const std::vector<StreamConfig>& earlier) const {
+                            const std::vector<StreamConfig>& earlier, std::optional<Where>& gyro_stream) const {
     const toml::table& t = table_of(node, prefix, "[[stream]]");
     check_keys(t, prefix, kStreamKeys);
     auto key = [&](std::string_view name) { return join_key(prefix, name); };
@@ -1202,8 +1210,16 @@ class Parser {
     if (const toml::node* n = t.get("spline")) s.spline = parse_spline(table_of(*n, key("spline"), "[stream.spline]"), key("spline"));
     if (const toml::node* n = t.get("fusion")) s.fusion = parse_fusion(table_of(*n, key("fusion"), "[stream.fusion]"), key("fusion"));
     // A fusion stage's orientation is already the gyro's integral: its gyro aids the fairing
-    // only when a table asks for it.
-    if (s.fusion && !global.gyro_aided && !(local && local->gyro_aided)) s.engine.gyro.enabled = false;
+    // only when a table asks for it (gyro_aided, or a gyro_stream).
+    if (s.fusion && !global.gyro_aided && !(local && (local->gyro_aided || local->gyro_stream))) s.engine.gyro.enabled = false;
+    if (local && local->gyro_stream) {
+      const Given<std::string>& g = *local->gyro_stream;
+      if (!s.engine.gyro.enabled) fail(g.where, "needs gyro-aided fairing, which gyro_aided = false turns off for this stream");
+      if (s.engine.solver != WindowSolver::Linear || s.engine.horizon_s > 0.0)
+        fail(g.where, "gyro-aided fairing needs the linear solver and no horizon");
+      s.gyro_stream = g.value;
+      gyro_stream = g.where;
+    }
     if (const toml::node* n = t.get("gpio")) {
       std::optional<Given<double>> rate = local && local->rate_hz ? local->rate_hz : driver_rate ? driver_rate : global.rate_hz;
       s.gpio = parse_gpio(table_of(*n, key("gpio"), "[stream.gpio]"), key("gpio"), rate);
@@ -1211,6 +1227,43 @@ class Parser {
     if (const toml::node* n = t.get("mounting")) s.frame.mounting = get_rotation(*n, key("mounting"));
     if (const toml::node* n = t.get("world")) s.frame.world = get_rotation(*n, key("world"));
     return s;
+  }
+
+  // [stream.engine] gyro_stream, once every stream is known: the name of another stream that
+  // can deliver a gyroscope, and no cycle (a → b → a), so the engine can take each source's
+  // readings before the samples they pair with.
+  void check_gyro_streams(const std::vector<StreamConfig>& streams, const std::vector<std::optional<Where>>& given) const {
+    auto index_of = [&](const std::string& name) {
+      for (std::size_t j = 0; j < streams.size(); ++j)
+        if (streams[j].name == name) return j;
+      return streams.size();
+    };
+    for (std::size_t i = 0; i < streams.size(); ++i) {
+      if (!given[i]) continue;
+      const std::string& name = streams[i].gyro_stream;
+      const std::size_t j = index_of(name);
+      if (j == streams.size()) {
+        std::string names;
+        for (const StreamConfig& s : streams) names += (names.empty() ? "" : ", ") + in_quotes(s.name);
+        fail(*given[i], "no stream named " + in_quotes(name) + " (streams: " + names + ")");
+      }
+      if (j == i) fail(*given[i], "names this stream itself: the gyroscope must come from another stream on the same body");
+      const DriverConfig& d = streams[j].driver;
+      const std::string source = in_quotes(name) + " (" + element_key("stream", j) + ")";
+      if (d.type == DriverType::Synthetic) fail(*given[i], "stream " + source + " has no gyroscope: a synthetic source makes orientations only");
+      if (d.type == DriverType::Replay && d.replay.candump.empty() && !drivers::is_sample_log(d.replay.path))
+        fail(*given[i], "stream " + source + " has no gyroscope: it replays a pose file (" + d.replay.path.filename().string() +
+                            "), which holds orientations only; a sample log holds readings");
+      // Each stream names at most one source: follow the chain; coming back to i is a cycle.
+      std::string chain = in_quotes(streams[i].name);
+      for (std::size_t k = j, steps = 0; steps < streams.size(); ++steps) {
+        chain += " -> " + in_quotes(streams[k].name);
+        if (k == i) fail(*given[i], "forms a cycle of gyro_stream: " + chain);
+        if (streams[k].gyro_stream.empty()) break;
+        k = index_of(streams[k].gyro_stream);
+        if (k == streams.size()) break;  // reported at that stream's own key
+      }
+    }
   }
 
   // A rotation ([[stream]] mounting, world): [yaw, pitch, roll] in degrees about posefair's

@@ -19,6 +19,7 @@
 #include "posefair/core/gap_bridge.hpp"
 #include "posefair/daemon/driver_factory.hpp"
 #include "posefair/daemon/fusion_stage.hpp"
+#include "posefair/daemon/gyro_pairing.hpp"
 #include "posefair/daemon/publisher.hpp"
 #include "posefair/daemon/ring_items.hpp"
 #include "posefair/daemon/spsc_ring.hpp"
@@ -188,6 +189,8 @@ struct Pipeline::Stream final : drivers::SampleSink {
   std::optional<FixedRateResampler> resampler;  // engine thread only; [stream.spline] publish_rate_hz
   std::vector<FairedPose> grid;                 // engine scratch
   std::optional<FusionStage> fusion;            // engine thread only; [stream.fusion]
+  std::optional<GyroPairing> gyro_pairing;      // engine thread only; [stream.engine] gyro_stream
+  std::vector<GyroPairing*> gyro_consumers;     // the pairings this stream's gyroscope readings go to
   StreamCounters counters;
   MadeGpioLines gpio;                           // [stream.gpio]: data-ready sink (driver thread), output line
   std::atomic<bool> driver_running{false};
@@ -232,6 +235,7 @@ Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
     ids.push_back(sc.id);
     frames.push_back(sc.frame);
   }
+  pair_gyro_streams();
   publisher_ = std::make_unique<Publisher>(session, ids, config_.outputs, first_sequence, frames, std::move(subscribers));
   if (record && !defer_recorder) {
     formats::SampleLogWriterOptions wo;
@@ -248,6 +252,30 @@ Pipeline::Pipeline(const DaemonConfig& config, std::uint32_t session,
 }
 
 Pipeline::~Pipeline() { stop(); }
+
+// [stream.engine] gyro_stream: each paired stream's source feeds its pairing, and the engine
+// visits a source before the streams it feeds, so a pass takes the readings before the samples
+// they match (the config refused cycles and unknown names).
+void Pipeline::pair_gyro_streams() {
+  auto find = [&](const std::string& name) -> Stream* {
+    for (auto& sp : streams_)
+      if (sp->config.name == name) return sp.get();
+    return nullptr;
+  };
+  for (auto& sp : streams_)
+    if (Stream* source = sp->config.gyro_stream.empty() ? nullptr : find(sp->config.gyro_stream)) {
+      sp->gyro_pairing.emplace();
+      source->gyro_consumers.push_back(&*sp->gyro_pairing);
+    }
+  std::vector<bool> placed(streams_.size(), false);
+  auto place = [&](auto&& self, Stream* s, std::size_t depth) -> void {
+    if (placed[s->index] || depth > streams_.size()) return;
+    if (Stream* source = s->config.gyro_stream.empty() ? nullptr : find(s->config.gyro_stream)) self(self, source, depth + 1);
+    placed[s->index] = true;
+    engine_order_.push_back(s);
+  };
+  for (auto& sp : streams_) place(place, sp.get(), 0);
+}
 
 void Pipeline::wake_engine() {
   engine_wake_.notify();
@@ -411,6 +439,7 @@ bool Pipeline::window_push(Stream& s, const Sample& sample, std::uint64_t enqueu
 bool Pipeline::fair(Stream& s, const Sample& raw, std::uint64_t enqueued_ns) {
   Sample sample = raw;
   if (s.fusion && !s.fusion->apply(sample)) return false;
+  if (s.gyro_pairing) s.gyro_pairing->apply(sample);
   if (!s.bridge) return window_push(s, sample, enqueued_ns);
   bool any = false;
   const std::size_t n = s.bridge->push(sample, s.bridged);
@@ -438,7 +467,7 @@ void Pipeline::flush_stream(Stream& s) {
 bool Pipeline::engine_pass() {
   heartbeat_.fetch_add(1, std::memory_order_relaxed);
   bool any = false;
-  for (auto& sp : streams_) {
+  for (Stream* sp : engine_order_) {
     Stream& s = *sp;
     RingSample r;
     bool emitted = false;
@@ -449,6 +478,8 @@ bool Pipeline::engine_pass() {
       stages_.ring_wait.record(engine_pop_ns_ - r.enqueued_ns);
       if (hooks_.before_engine_sample) hooks_.before_engine_sample(s.config.id);
       const Sample sample = unpack(r);
+      if (sample.has_gyro())
+        for (GyroPairing* p : s.gyro_consumers) p->add(sample.time, sample.gyro);
       // A raw-only sample's quaternion is a placeholder, not a measurement: without a fusion
       // stage ([stream.fusion]) to make an orientation from its readings it must not reach
       // the window (the recorder has it already). Counted, and the stream goes on.
@@ -476,6 +507,10 @@ bool Pipeline::engine_pass() {
     s.counters.clamped.store(w.clamped, std::memory_order_relaxed);
     s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
     store_engine_state(s.counters, s.window.state());
+    if (s.gyro_pairing) {
+      s.counters.gyro.matched.store(s.gyro_pairing->matched(), std::memory_order_relaxed);
+      s.counters.gyro.unmatched.store(s.gyro_pairing->unmatched(), std::memory_order_relaxed);
+    }
     if (s.bridge) {
       s.counters.bridged_gaps.store(s.bridge->counters().gaps, std::memory_order_relaxed);
       s.counters.bridged_samples.store(s.bridge->counters().samples, std::memory_order_relaxed);
@@ -660,6 +695,8 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.resampled = get(s.counters.resampled);
     st.matrix_lerp = s.config.spline.pose_interpolation == PoseInterpolation::MatrixLerp;
     st.lerp_fallbacks = get(s.counters.lerp_fallbacks);
+    if (s.gyro_pairing)
+      st.gyro_pairing = GyroPairingStats{s.config.gyro_stream, get(s.counters.gyro.matched), get(s.counters.gyro.unmatched)};
     if (s.fusion) {
       st.fusion = load_fusion_state(s.counters.fusion);
       st.fusion_waiting = get(s.counters.fusion.waiting);

@@ -57,9 +57,9 @@ std::string gpio_text(const std::optional<drivers::GpioDataReadyCounters>& in,
 
 // "; engine 285.7 Hz, window 128, rotation adapted: noise 0.0012 rad, motion 3.1 rad/s^2,
 //  cutoff 8.2 Hz (mu 352)" — the adaptation's measurements and choice, or the fixed smoothing.
-std::string engine_text(const EngineState& e) {
+std::string engine_text(const EngineState& e, const std::optional<GyroPairingStats>& pairing) {
   std::string text;
-  char buf[240];
+  char buf[400];
   if (e.rate_hz > 0.0)
     std::snprintf(buf, sizeof buf, "; engine %.4g Hz, window %d", e.rate_hz, e.window);
   else
@@ -76,11 +76,15 @@ std::string engine_text(const EngineState& e) {
   channel("rotation", e.rotation, "rad");
   // Positions once the adaptation has measured some (a stream without them shows none).
   if (e.position.adaptive ? e.position.noise > 0.0 : e.position.smoothing > 0.0) channel("position", e.position, "units");
-  // Gyro-aided fairing, once it has seen a gyro.
-  if (e.gyro.intervals > 0) {
+  // Gyro-aided fairing, once it has seen a gyro, or as soon as it is paired with another stream's.
+  if (e.gyro.intervals > 0 || pairing) {
     constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
-    std::snprintf(buf, sizeof buf, ", gyro-aided%s: bias (%.3f %.3f %.3f) deg/s, time offset %.2f ms (%s), intervals %" PRIu64,
-                  e.gyro.active ? "" : " (not now)", e.gyro.bias.x() * kDegPerRad, e.gyro.bias.y() * kDegPerRad,
+    std::string from;
+    if (pairing)
+      from = " from '" + pairing->source + "' (matched " + std::to_string(pairing->matched) + ", unmatched " +
+             std::to_string(pairing->unmatched) + ")";
+    std::snprintf(buf, sizeof buf, ", gyro-aided%s%s: bias (%.3f %.3f %.3f) deg/s, time offset %.2f ms (%s), intervals %" PRIu64,
+                  from.c_str(), e.gyro.active ? "" : " (not now)", e.gyro.bias.x() * kDegPerRad, e.gyro.bias.y() * kDegPerRad,
                   e.gyro.bias.z() * kDegPerRad, 1e3 * e.gyro.time_offset_s, e.gyro.offset_estimated ? "estimated" : "configured",
                   e.gyro.intervals);
     text += buf;
@@ -137,7 +141,7 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
                     s.fusion_waiting, f.nonfinite, f.gyro_saturated, f.mag_stuck, f.mag_absent, f.bad_time_steps, f.gaps);
       lines.back() += buf;
     }
-    lines.back() += engine_text(s.engine);
+    lines.back() += engine_text(s.engine, s.gyro_pairing);
     if (s.device) lines.back() += device_text(*s.device);
     lines.back() += gpio_text(s.data_ready, s.gpio_output);
   }
@@ -162,7 +166,13 @@ std::string status_line(const std::vector<StreamStats>& now, const std::vector<S
       std::snprintf(buf, sizeof buf, " raw-only %" PRIu64 " unfused", s.raw_unfused);
       out += buf;
     }
-    // Gyro-aided fairing: its time offset and the size of its bias estimate.
+    // Gyro-aided fairing: its time offset and the size of its bias estimate; with a gyro_stream,
+    // the source and how many samples found no reading of it.
+    if (s.gyro_pairing) {
+      std::snprintf(buf, sizeof buf, " gyro from %s unmatched %" PRIu64 "%s", s.gyro_pairing->source.c_str(),
+                    s.gyro_pairing->unmatched, s.engine.gyro.active ? "" : " (not aided now)");
+      out += buf;
+    }
     if (s.engine.gyro.active) {
       std::snprintf(buf, sizeof buf, " gyro dt %.1fms bias %.2fdeg/s", 1e3 * s.engine.gyro.time_offset_s,
                     s.engine.gyro.bias.norm() * 180.0 / 3.14159265358979323846);

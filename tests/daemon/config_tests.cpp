@@ -675,6 +675,37 @@ fusion = { tau_acc = 4 }
   EXPECT_EQ(std::get<double>(c.streams[2].fusion->options.at("tau_acc")), 4.0);  // an integer taken as a float
 }
 
+// [stream.engine] gyro_stream names another stream; the pair keeps the stream's gyro keys, and
+// a source with a fusion stage (a raw IMU) keeps its own gyro aiding off.
+TEST(Config, AGyroStreamNamesAnotherStreamOnTheBody) {
+  posefair::testing::ScratchDir dir("posefair-config-");
+  write_file(dir / "optical.tum", "0 0 0 0 0 0 0 1\n");
+  const DaemonConfig c = parse_config(R"toml(
+[[stream]]
+id = 1
+name = "optical"
+driver = { type = "replay", path = "optical.tum" }
+[stream.engine]
+gyro_stream = "imu"
+gyro_mounting = [90, 0, 0]
+gyro_time_offset = 0.004
+
+[[stream]]
+id = 2
+name = "imu"
+driver = { type = "serial", device = "/dev/ttyUSB0", protocol = "xsens" }
+fusion = { magnetometer = false }
+)toml",
+                                      dir / "paired.toml");
+  ASSERT_EQ(c.streams.size(), 2u);
+  EXPECT_EQ(c.streams[0].gyro_stream, "imu");
+  EXPECT_TRUE(c.streams[0].engine.gyro.enabled);
+  EXPECT_DOUBLE_EQ(c.streams[0].engine.gyro.time_offset_s, 0.004);
+  EXPECT_LT(so3::rotation_angle(c.streams[0].engine.gyro.mounting, so3::from_rotation_vector(Vec3(0, 0, M_PI / 2))), 1e-9);
+  EXPECT_EQ(c.streams[1].gyro_stream, "");
+  EXPECT_FALSE(c.streams[1].engine.gyro.enabled);
+}
+
 TEST(Config, PoseInterpolationIsTheSplineUnlessMatrixLerpIsChosen) {
   const DaemonConfig c = parse_config(R"toml(
 [[stream]]
@@ -1042,7 +1073,7 @@ struct BadConfig {
   std::uint32_t line;    // 0: the message carries no line
 };
 
-// Files in the scratch directory the rows may name: poses.csv, walk.bvh (contents unread).
+// Files in the scratch directory the rows may name: poses.csv, walk.bvh, imu.pflog (contents unread).
 const std::vector<BadConfig> kBadConfigs = {
     {"syntax error", R"([[stream]]
 id = = 1
@@ -1382,6 +1413,96 @@ id = 1
 name = "a"
 driver = { type = "synthetic", rate_hz = 100 }
 )", "engine.gyro_mounting: ", 2},
+    {"gyro_stream naming no stream", R"([[stream]]
+id = 1
+name = "optical"
+driver = { type = "replay", path = "poses.csv" }
+engine = { gyro_stream = "imu" }
+[[stream]]
+id = 2
+name = "imu2"
+driver = { type = "replay", path = "imu.pflog" }
+)", "stream[1].engine.gyro_stream: no stream named 'imu' (streams: 'optical', 'imu2')", 5},
+    {"gyro_stream naming its own stream", R"([[stream]]
+id = 1
+name = "optical"
+driver = { type = "replay", path = "poses.csv" }
+[stream.engine]
+gyro_stream = "optical"
+)", "stream[1].engine.gyro_stream: names this stream itself", 6},
+    {"gyro_stream naming a synthetic stream", R"([[stream]]
+id = 1
+name = "optical"
+driver = { type = "replay", path = "poses.csv" }
+[stream.engine]
+gyro_stream = "gen"
+[[stream]]
+id = 2
+name = "gen"
+driver = { type = "synthetic", rate_hz = 1000 }
+)", "stream[1].engine.gyro_stream: stream 'gen' (stream[2]) has no gyroscope: a synthetic source", 6},
+    {"gyro_stream naming a pose file replay", R"([[stream]]
+id = 1
+name = "optical"
+driver = { type = "replay", path = "imu.pflog" }
+[[stream]]
+id = 2
+name = "other"
+driver = { type = "replay", path = "poses.csv" }
+[stream.engine]
+gyro_stream = "optical"
+[[stream]]
+id = 3
+name = "third"
+driver = { type = "replay", path = "imu.pflog" }
+engine = { gyro_stream = "other" }
+)", "stream[3].engine.gyro_stream: stream 'other' (stream[2]) has no gyroscope: it replays a pose file (poses.csv)", 15},
+    {"gyro_stream cycle", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "replay", path = "imu.pflog" }
+engine = { gyro_stream = "b" }
+[[stream]]
+id = 2
+name = "b"
+driver = { type = "replay", path = "imu.pflog" }
+engine = { gyro_stream = "a" }
+)", "stream[1].engine.gyro_stream: forms a cycle of gyro_stream: 'a' -> 'b' -> 'a'", 5},
+    {"gyro_stream in [engine]", R"([engine]
+gyro_stream = "imu"
+[[stream]]
+id = 1
+name = "imu"
+driver = { type = "replay", path = "imu.pflog" }
+)", "engine.gyro_stream: only in [stream.engine]", 2},
+    {"gyro_stream not a string", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "replay", path = "poses.csv" }
+engine = { gyro_stream = 2 }
+)", "stream[1].engine.gyro_stream: expected a string, got an integer", 5},
+    {"gyro_stream with gyro aiding off", R"([engine]
+gyro_aided = false
+[[stream]]
+id = 1
+name = "optical"
+driver = { type = "replay", path = "poses.csv" }
+engine = { gyro_stream = "imu" }
+[[stream]]
+id = 2
+name = "imu"
+driver = { type = "replay", path = "imu.pflog" }
+)", "stream[1].engine.gyro_stream: needs gyro-aided fairing, which gyro_aided = false turns off", 7},
+    {"gyro_stream with a horizon", R"([[stream]]
+id = 1
+name = "optical"
+driver = { type = "replay", path = "poses.csv" }
+engine = { gyro_stream = "imu", horizon = 0.02 }
+[[stream]]
+id = 2
+name = "imu"
+driver = { type = "replay", path = "imu.pflog" }
+)", "stream[1].engine.gyro_stream: gyro-aided fairing needs the linear solver and no horizon", 5},
     {"window_time out of range", R"([engine]
 window_time = 0
 [[stream]]
@@ -2160,6 +2281,7 @@ TEST(Config, MalformedConfigsAreRefusedWithFileLineAndKey) {
   write_file(dir / "poses.csv", "t,qw,qx,qy,qz\n0,1,0,0,0\n");
   write_file(dir / "walk.bvh", "");
   write_file(dir / "bus.log", "(1.000000) can0 021#7FFF000000000000\n");
+  write_file(dir / "imu.pflog", "");  // a sample log by its name (contents unread)
   const std::filesystem::path file = dir / "cfg.toml";
   EXPECT_GE(kBadConfigs.size(), 25u);
   for (const BadConfig& bad : kBadConfigs) {

@@ -23,5 +23,6 @@ add_dependencies(daemon_e2e_tests posefaird posefair)
 
 # status_report_tests.cpp: the counter lines and STATUS= text, with and without a device link;
 # in config_tests (CMakeLists.txt here), which has the same label.
-target_sources(config_tests PRIVATE status_report_tests.cpp)
+# gyro_pairing_tests.cpp: [stream.engine] gyro_stream's matcher, in the same program.
+target_sources(config_tests PRIVATE status_report_tests.cpp gyro_pairing_tests.cpp)
 target_link_libraries(config_tests PRIVATE posefair::service)

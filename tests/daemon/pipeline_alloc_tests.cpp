@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <utility>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -84,34 +85,37 @@ std::string replay_driver() { return "type = \"replay\"\npath = \"" + kDemoCsv.s
 struct PipelineRun {
   bool ended = false;                     // the source ended on its own
   int threads = 0;                        // real-time threads that claimed a counter slot
-  int expected_threads = 0;               // the engine, and the publisher unless the engine publishes
+  int expected_threads = 0;               // the engine, the publisher unless the engine publishes, the drivers that faired
   std::vector<std::size_t> allocations;   // per claimed slot, over the whole run
   StreamStats stats;
   std::uint64_t datagrams = 0;
 };
 
-// Runs the pipeline until its source ends, stops it (which joins the engine and publisher
-// threads) and reads what each real-time thread allocated.
-PipelineRun run_pipeline(const std::string& driver, const std::string& solver, const std::string& encoding,
-                         std::shared_ptr<SubscriberTable> subscribers = nullptr, const std::string& daemon_keys = "") {
+// Runs the pipeline of config_text(port) until its sources end, stops it (which joins the
+// engine and publisher threads) and reads what each real-time thread allocated.
+PipelineRun run_config(const std::function<std::string(std::uint16_t port)>& config_text,
+                       std::shared_ptr<SubscriberTable> subscribers = nullptr) {
   PipelineRun run;
   UdpCollector receiver;  // the output's destination; its thread claims no counter slot
-  const DaemonConfig config =
-      parse_config(config_text(receiver.port(), driver, solver, encoding, daemon_keys), "/virtual/pipeline-alloc.toml");
-  // The engine thread, the publisher's unless the engine publishes, and with fair_on = "driver"
-  // the stream's driver thread while it fairs.
-  run.expected_threads = (config.daemon.publish_on == PublishThread::Engine ? 1 : 2) +
-                         (config.daemon.fair_on == FairThread::Driver ? 1 : 0);
+  const DaemonConfig config = parse_config(config_text(receiver.port()), "/virtual/pipeline-alloc.toml");
+  const bool drivers_fair = config.daemon.fair_on == FairThread::Driver;
+  // The engine thread, and the publisher's unless the engine publishes; with fair_on = "driver"
+  // also each driver thread that took the engine role (counted while it held it).
+  const int base_threads = config.daemon.publish_on == PublishThread::Engine ? 1 : 2;
+  static std::atomic<int> fairing_drivers{0};
+  fairing_drivers.store(0);
   PipelineHooks hooks;
   // Stateless, so calling it allocates nothing; claiming a slot does not allocate either.
   hooks.on_realtime_thread_start = [] { counting::claim_counter_slot(); };
   hooks.on_engine_role = [](bool held) {
-    if (!held)
+    if (!held) {
       counting::suspend_counter_slot();
-    else if (counting::has_counter_slot())
+    } else if (counting::has_counter_slot()) {
       counting::resume_counter_slot();
-    else
+    } else {
       counting::claim_counter_slot();
+      fairing_drivers.fetch_add(1);
+    }
   };
   {
     Pipeline pipeline(config, kSession, {}, false, hooks, subscribers);
@@ -122,21 +126,32 @@ PipelineRun run_pipeline(const std::string& driver, const std::string& solver, c
     if (!stats.empty()) run.stats = stats.front();
   }
   run.threads = counting::counter_slots_claimed();
+  run.expected_threads = base_threads + fairing_drivers.load();
+  // With fair_on = "driver" a driver thread faired (or the slots would not see the fairing).
+  if (drivers_fair && fairing_drivers.load() == 0) run.expected_threads = -1;
   for (int i = 0; i < run.threads; ++i) run.allocations.push_back(counting::slot_allocations(i));
   receiver.drain(100ms, 5s);
   run.datagrams = receiver.datagrams();
   return run;
 }
 
+// One stream (config_text above) to one output.
+PipelineRun run_pipeline(const std::string& driver, const std::string& solver, const std::string& encoding,
+                         std::shared_ptr<SubscriberTable> subscribers = nullptr, const std::string& daemon_keys = "") {
+  return run_config([&](std::uint16_t port) { return config_text(port, driver, solver, encoding, daemon_keys); },
+                    std::move(subscribers));
+}
+
 // Writes samples (stream 1) to a sample log at path; the replay driver's table body for it.
-std::string replay_of(const std::filesystem::path& path, const std::vector<Sample>& samples) {
+std::string replay_of(const std::filesystem::path& path, const std::vector<Sample>& samples,
+                      const std::string& timing = "timing = \"fast\"\n") {
   formats::SampleLogHeader h;
   h.streams = {{1, "imu", "test"}};
   formats::SampleLogWriterOptions o;
   o.sync = false;
   formats::SampleLogWriter w(path, h, o);
   for (const Sample& s : samples) w.append(s);
-  return "type = \"replay\"\npath = \"" + path.string() + "\"\ntiming = \"fast\"\n";
+  return "type = \"replay\"\npath = \"" + path.string() + "\"\n" + timing;
 }
 
 std::string describe(const PipelineRun& run) {
@@ -248,6 +263,40 @@ TEST_F(PipelineAllocation, GyroAidedFairingAllocatesNothingOnTheRealtimeThreads)
   EXPECT_EQ(run.stats.published, 1000u);
   EXPECT_TRUE(run.stats.engine.gyro.active);
   EXPECT_GT(run.stats.engine.gyro.intervals, 900u);
+}
+
+// An orientation stream faired with the gyroscope of another stream ([stream.engine]
+// gyro_stream): the IMU's readings kept for the pairing and matched to each sample, on the
+// engine thread, allocate nothing either. Replayed in real time (4x), the IMU's readings
+// beginning 0.1 s after the tracker's samples so that they lead them, and are matched.
+TEST_F(PipelineAllocation, AGyroFromAnotherStreamAllocatesNothingOnTheRealtimeThreads) {
+  posefair::testing::ScratchDir dir;
+  posefair::testing::GyroTrackerSpec optical;
+  optical.rate_hz = 120.0;
+  optical.seconds = 2.0;
+  std::vector<Sample> tracker = posefair::testing::make_gyro_tracker_stream(optical).samples;
+  for (Sample& x : tracker) x.flags &= ~static_cast<std::uint32_t>(kHasGyro);
+  posefair::testing::GyroTrackerSpec imu;
+  imu.rate_hz = 1000.0;
+  imu.start_time = 0.1;
+  imu.seconds = optical.seconds - imu.start_time;
+  imu.offset = 0.003;
+  const std::string real_time = "speed = 4.0\n";
+  const std::string tracker_driver = replay_of(dir / "optical.pflog", tracker, real_time);
+  const std::string imu_driver = replay_of(dir / "imu.pflog", posefair::testing::make_imu_readings(imu), real_time);
+  const PipelineRun run = run_config([&](std::uint16_t port) {
+    return "[[stream]]\nid = 1\nname = \"optical\"\nring_capacity = 4096\n[stream.driver]\n" + tracker_driver +
+           "[stream.engine]\ngyro_stream = \"imu\"\n[[stream]]\nid = 2\nname = \"imu\"\nring_capacity = 4096\n"
+           "[stream.driver]\n" + imu_driver + "[[output]]\ndestinations = [\"127.0.0.1:" + std::to_string(port) + "\"]\n";
+  });
+  SCOPED_TRACE(describe(run));
+  EXPECT_TRUE(run.ended);
+  ASSERT_EQ(run.threads, run.expected_threads);
+  for (std::size_t a : run.allocations) EXPECT_EQ(a, 0u) << "a real-time thread allocated";
+  EXPECT_EQ(run.stats.published, tracker.size());
+  ASSERT_TRUE(run.stats.gyro_pairing);
+  EXPECT_GT(run.stats.gyro_pairing->matched, tracker.size() / 2);
+  EXPECT_GT(run.stats.engine.gyro.intervals, 0u);
 }
 
 TEST_F(PipelineAllocation, GaussNewtonOnASyntheticStreamAllocatesNothingOnTheRealtimeThreads) {

@@ -56,6 +56,30 @@ TEST(StatusReport, RawOnlySamplesShowWithTheirReason) {
       << status_line({s}, {}, 1.0);
 }
 
+// [stream.engine] gyro_stream: the gyro part names the source and its matches from the start,
+// before any interval was aided, and STATUS= says how many samples found no reading.
+TEST(StatusReport, AGyroFromAnotherStreamShowsItsSourceAndMatches) {
+  StreamStats s = stream(1, "optical", 100);
+  s.gyro_pairing = GyroPairingStats{"imu", 0, 100};
+  EXPECT_NE(counter_lines({s}, {}, 0.0)[0].find(", gyro-aided from 'imu' (matched 0, unmatched 100) (not now): bias (0.000 0.000 "
+                                                "0.000) deg/s, time offset 0.00 ms (configured), intervals 0"),
+            std::string::npos)
+      << counter_lines({s}, {}, 0.0)[0];
+  EXPECT_NE(status_line({s}, {}, 1.0).find(" gyro from imu unmatched 100 (not aided now)"), std::string::npos)
+      << status_line({s}, {}, 1.0);
+  s.gyro_pairing = GyroPairingStats{"imu", 1400, 100};
+  s.engine.gyro.active = true;
+  s.engine.gyro.intervals = 1390;
+  s.engine.gyro.time_offset_s = 0.004;
+  s.engine.gyro.offset_estimated = true;
+  EXPECT_NE(counter_lines({s}, {}, 0.0)[0].find(", gyro-aided from 'imu' (matched 1400, unmatched 100): bias (0.000 0.000 0.000) "
+                                                "deg/s, time offset 4.00 ms (estimated), intervals 1390"),
+            std::string::npos)
+      << counter_lines({s}, {}, 0.0)[0];
+  EXPECT_NE(status_line({s}, {}, 1.0).find(" gyro from imu unmatched 100 gyro dt 4.0ms bias 0.00deg/s"), std::string::npos)
+      << status_line({s}, {}, 1.0);
+}
+
 TEST(StatusReport, CounterLineAndStatusCarryTheEngineAdaptation) {
   StreamStats s = stream(1, "head", 2000);
   const auto unknown = counter_lines({s}, {}, 0.0);

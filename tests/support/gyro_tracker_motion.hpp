@@ -60,4 +60,26 @@ inline GyroTrackerStream make_gyro_tracker_stream(const GyroTrackerSpec& spec) {
   return g;
 }
 
+// The motion of a make_gyro_tracker_stream with start_time 0, seen by a separate IMU on the
+// body (a gyro_stream source): raw-only samples (kNoOrientation) at spec.rate_hz whose readings
+// begin at spec.start_time, each carrying only the gyro reading (spec's mounting, bias and
+// offset) plus white noise of gyro_noise rad/s per axis.
+inline std::vector<Sample> make_imu_readings(const GyroTrackerSpec& spec, double gyro_noise = 0.0) {
+  std::mt19937_64 rng(spec.seed + 1000);
+  std::normal_distribution<double> n(0.0, gyro_noise);
+  std::vector<Sample> out;
+  const auto count = static_cast<std::size_t>(std::lround(spec.seconds * spec.rate_hz));
+  for (std::size_t i = 0; i < count; ++i) {
+    const double t = spec.start_time + static_cast<double>(i) / spec.rate_hz;
+    Sample s;
+    s.stream_id = 1;
+    s.sequence = i;
+    s.time = t;
+    s.gyro = spec.mounting.conjugate() * tracker_body_rate(t - spec.offset) + spec.bias + Vec3(n(rng), n(rng), n(rng));
+    s.flags = kHasGyro | kNoOrientation;
+    out.push_back(s);
+  }
+  return out;
+}
+
 }  // namespace posefair::testing

@@ -211,6 +211,9 @@ struct StreamConfig {
   // validated (posefair::validate) and in the engine's units (epsilon_r as dist on S³, i.e.
   // half the rotation angle given in the file; smoothing from cutoff_hz when that was given).
   WindowConfig engine;
+  // [stream.engine] gyro_stream: the name of another stream on the same body whose gyroscope
+  // readings this stream's samples get for gyro-aided fairing (gyro_pairing.hpp); empty: none.
+  std::string gyro_stream;
   SplineConfig spline;
   std::optional<GpioConfig> gpio;
   std::optional<FusionConfig> fusion;

@@ -120,6 +120,7 @@ class Pipeline {
   bool window_push(Stream& s, const Sample& sample, std::uint64_t enqueued_ns);
   bool fair(Stream& s, const Sample& sample, std::uint64_t enqueued_ns);
   void flush_stream(Stream& s);
+  void pair_gyro_streams();
   bool busy_polling() const;  // a busy_poll stream's driver still runs
   void publisher_loop();
   void recorder_loop();
@@ -129,6 +130,7 @@ class Pipeline {
   DaemonConfig config_;
   PipelineHooks hooks_;
   std::vector<std::unique_ptr<Stream>> streams_;
+  std::vector<Stream*> engine_order_;  // streams_, each gyro_stream source before the streams it feeds
   std::vector<std::string> warnings_;
   formats::SampleLogHeader header_;
   std::unique_ptr<class Publisher> publisher_;

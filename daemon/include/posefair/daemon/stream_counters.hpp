@@ -45,12 +45,13 @@ struct StreamCounters {
   std::atomic<int> engine_window{0};
   Channel rotation, position;
   // Gyro-aided fairing (EngineState::gyro): whether the window uses a gyro now, and its
-  // estimated bias and time offset.
+  // estimated bias and time offset; with a gyro_stream, the samples that got a reading from it.
   struct Gyro {
     std::atomic<bool> active{false}, offset_estimated{false};
     std::atomic<double> bias_x{0.0}, bias_y{0.0}, bias_z{0.0};  // rad/s, gyro frame
     std::atomic<double> time_offset_s{0.0};
     std::atomic<std::uint64_t> intervals{0};
+    std::atomic<std::uint64_t> matched{0}, unmatched{0};  // gyro_pairing.hpp
   };
   Gyro gyro;
   // [stream.fusion]: the estimator's state and counters (EstimatorState), written by the
@@ -64,6 +65,13 @@ struct StreamCounters {
     std::atomic<double> bias_x{0.0}, bias_y{0.0}, bias_z{0.0};  // rad/s
   };
   Fusion fusion;
+};
+
+// [stream.engine] gyro_stream: the source stream's name and the samples that got a reading
+// from it (matched) or none (unmatched: no reading of the source in their interval).
+struct GyroPairingStats {
+  std::string source;
+  std::uint64_t matched = 0, unmatched = 0;
 };
 
 // A consistent-enough copy for reporting (each field read once, relaxed).
@@ -85,6 +93,7 @@ struct StreamStats {
   std::optional<drivers::GpioDataReadyCounters> data_ready;  // [stream.gpio] data_ready_line
   std::optional<drivers::GpioOutputCounters> gpio_output;    // [stream.gpio] output_line
   std::optional<EstimatorState> fusion;                      // [stream.fusion]
+  std::optional<GyroPairingStats> gyro_pairing;              // [stream.engine] gyro_stream
   std::uint64_t fusion_waiting = 0;                          // raw samples before its first accelerometer reading
   // Poses lost on the way to subscribers: overflow of the engine's and the publisher's rings.
   std::uint64_t dropped() const { return ring_dropped + publish_dropped; }

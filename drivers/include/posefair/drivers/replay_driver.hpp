@@ -47,6 +47,10 @@ struct ReplayOptions {
   bool follow_rotation = true;
 };
 
+// A replay plays `path` as a sample log (named *.pflog, or starting with the log's magic),
+// else as a pose file.
+bool is_sample_log(const std::filesystem::path& path);
+
 class ReplayDriver final : public Driver {
  public:
   // Loads the whole source now. A file named *.pflog or starting with the sample log magic
