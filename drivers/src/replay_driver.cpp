@@ -7,8 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
-#include <cstdio>
-#include <cstring>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -21,15 +19,6 @@ namespace posefair::drivers {
 
 namespace {
 
-bool starts_with_log_magic(const std::filesystem::path& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rbe");
-  if (f == nullptr) return false;
-  unsigned char head[sizeof formats::kSampleLogMagic] = {};
-  const std::size_t n = std::fread(head, 1, sizeof head, f);
-  std::fclose(f);
-  return n == sizeof head && std::memcmp(head, formats::kSampleLogMagic, sizeof head) == 0;
-}
-
 // Span + mean spacing of a set of values (the shift per loop round); 1 s when they do not span.
 double loop_period(double lo, double hi, std::size_t n) {
   if (!(hi > lo) || n < 2) return 1.0;
@@ -41,7 +30,7 @@ double loop_period(double lo, double hi, std::size_t n) {
 
 ReplayDriver::ReplayDriver(const std::filesystem::path& source, ReplayOptions options)
     : options_(std::move(options)), name_("replay:" + source.filename().string()) {
-  if (starts_with_log_magic(source) || source.extension() == ".pflog") {
+  if (formats::is_sample_log_file(source)) {
     formats::SampleLogContents log = options_.follow_rotation ? formats::read_sample_log_set(source) : formats::read_sample_log(source);
     samples_ = std::move(log.samples);
     streams_ = std::move(log.header.streams);
