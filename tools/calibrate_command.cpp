@@ -1,4 +1,4 @@
-// posefair calibrate (docs/fusion.md): the magnetometer readings of a raw IMU CSV fitted with
+// posefair calibrate (docs/fusion.md): the magnetometer readings of a raw IMU CSV or sample log fitted with
 // an ellipsoid; the calibration written as text for posefair fuse --mag-calibration.
 #include "calibrate_command.hpp"
 
@@ -14,7 +14,7 @@
 #include "posefair/core/error.hpp"
 #include "posefair/core/magnetometer_calibration.hpp"
 #include "posefair/formats/atomic_write.hpp"
-#include "posefair/formats/imu_csv.hpp"
+#include "posefair/formats/imu_recording_file.hpp"
 #include "posefair/formats/magnetometer_calibration_file.hpp"
 
 namespace posefair::tools {
@@ -22,7 +22,7 @@ namespace posefair::tools {
 namespace {
 
 struct CalibrateOptions {
-  std::string input, output;
+  std::string input, output, stream;
 };
 
 int run_calibrate(const CalibrateOptions& o) {
@@ -32,9 +32,14 @@ int run_calibrate(const CalibrateOptions& o) {
   }
   std::vector<Vec3> readings;
   try {
-    const formats::ImuRecording rec = formats::read_imu_csv(o.input);
-    for (const Sample& s : rec.samples)
+    const formats::ImuRecordingFile input = formats::read_imu_recording_file(o.input, o.stream);
+    for (const Sample& s : input.recording.samples)
       if (s.has_mag()) readings.push_back(s.mag);
+    for (const formats::SampleLogProblem& p : input.damage)
+      std::cerr << "posefair calibrate: warning: " << p.message << " (the readings before it are used)\n";
+  } catch (const Error& e) {
+    std::cerr << "posefair calibrate: " << e.what() << "\n";
+    return e.exit_code();
   } catch (const std::exception& e) {
     std::cerr << "posefair calibrate: " << e.what() << "\n";
     return exit_code(ErrorKind::DataErr);
@@ -67,8 +72,11 @@ int run_calibrate(const CalibrateOptions& o) {
 void add_calibrate_command(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<CalibrateOptions>();
   auto* cmd = app.add_subcommand("calibrate", "Magnetometer hard- and soft-iron calibration from a raw IMU recording");
-  cmd->add_option("input", o->input, "raw IMU CSV with mag_x/y/z columns, recorded while turning the sensor every way")
+  cmd->add_option("input", o->input,
+                  "raw IMU CSV with mag_x/y/z columns, or a sample log (.pflog) with magnetometer readings, recorded "
+                  "while turning the sensor every way")
       ->required();
+  cmd->add_option("--stream", o->stream, "the log stream to read, by name or id (when several have raw samples)");
   cmd->add_option("-o,--output", o->output, "calibration file to write (for posefair fuse --mag-calibration)")->required();
   cmd->callback([o, &exit_code] { exit_code = run_calibrate(*o); });
 }

@@ -1,4 +1,4 @@
-// posefair fuse (docs/fusion.md): raw IMU CSV in, orientation out.
+// posefair fuse (docs/fusion.md): raw IMU CSV or a sample log stream in, orientation out.
 #include "fuse_command.hpp"
 
 #include <filesystem>
@@ -13,6 +13,7 @@
 #include "estimator_option_text.hpp"
 #include "fusion_run.hpp"
 #include "posefair/core/error.hpp"
+#include "posefair/formats/imu_recording_file.hpp"
 #include "posefair/formats/magnetometer_calibration_file.hpp"
 #include "posefair/formats/pose_file.hpp"
 
@@ -21,7 +22,7 @@ namespace posefair::tools {
 namespace {
 
 struct FuseOptions {
-  std::string input, output, estimator = "vqf", calibration;
+  std::string input, output, estimator = "vqf", calibration, stream;
   std::vector<std::string> settings;
   bool six_d = false;
 };
@@ -52,15 +53,22 @@ int run_fuse(const FuseOptions& o) {
     std::cerr << "posefair fuse: cannot open " << o.input << "\n";
     return exit_code(ErrorKind::NoInput);
   }
-  formats::ImuRecording recording;
+  formats::ImuRecordingFile input;
   std::optional<MagnetometerCalibration> calibration;
   try {
     if (!o.calibration.empty()) calibration = formats::read_magnetometer_calibration(o.calibration);
-    recording = formats::read_imu_csv(o.input);
+    input = formats::read_imu_recording_file(o.input, o.stream);
+  } catch (const Error& e) {
+    std::cerr << "posefair fuse: " << e.what() << "\n";
+    return e.exit_code();
   } catch (const std::exception& e) {
     std::cerr << "posefair fuse: " << e.what() << "\n";
     return exit_code(ErrorKind::DataErr);
   }
+  // A damaged log: what precedes the damage is good and is fused; the rest is named.
+  for (const formats::SampleLogProblem& p : input.damage)
+    std::cerr << "posefair fuse: warning: " << p.message << "; " << p.unread_bytes << " bytes after it not read\n";
+  formats::ImuRecording& recording = input.recording;
   if (calibration)
     for (Sample& s : recording.samples)
       if (s.has_mag()) s.mag = calibration->apply(s.mag);
@@ -86,7 +94,9 @@ int run_fuse(const FuseOptions& o) {
     std::cerr << "posefair fuse: " << e.what() << "\n";
     return exit_code(ErrorKind::CantCreate);
   }
-  std::cout << "fused " << poses.size() << " samples of " << o.input << " with " << entry->name
+  std::cout << "fused " << poses.size() << " samples of " << o.input;
+  if (input.from_sample_log) std::cout << ", stream " << input.stream << ",";
+  std::cout << " with " << entry->name
             << (o.six_d ? " (6D)" : "") << " into " << o.output << "\n"
             << describe_estimator_state(estimator->state()) << "\n";
   return kExitOk;
@@ -97,8 +107,12 @@ int run_fuse(const FuseOptions& o) {
 void add_fuse_command(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<FuseOptions>();
   auto* cmd = app.add_subcommand("fuse", "Orientation from raw gyroscope, accelerometer and magnetometer readings");
-  cmd->add_option("input", o->input, "raw IMU CSV (BROAD's columns: t_s, gyr_*, acc_*, mag_*; docs/fusion.md)")
+  cmd->add_option("input", o->input,
+                  "raw IMU CSV (BROAD's columns: t_s, gyr_*, acc_*, mag_*; docs/fusion.md) or a sample log (.pflog, "
+                  "posefaird's recording) with raw samples")
       ->required();
+  cmd->add_option("--stream", o->stream,
+                  "the log stream to fuse, by name or id (needed when several streams have raw samples)");
   cmd->add_option("-o,--output", o->output, "file to write: .txt/.tum (TUM) or .csv (t,qw,qx,qy,qz), sensor to ENU")
       ->required();
   cmd->add_option("-e,--estimator", o->estimator, "vqf, madgwick or mahony")->capture_default_str();

@@ -454,8 +454,11 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   const GateVerdict verdict = gate_.check(s);
   if (verdict != GateVerdict::Accept && verdict != GateVerdict::AcceptAfterGap) return 0;
   int count = 0;
-  // A gap, or a change between samples with and without positions or gyro, starts a new window.
-  if (n_ > 0 && (verdict == GateVerdict::AcceptAfterGap || s.has_position() != positions_ || gyro_aided(s) != aided_)) {
+  // A gap, or a change between samples with and without positions or gyro, starts a new window;
+  // a gyro-aided window bridges a few missing readings instead (gyro_aiding.hpp).
+  const bool bridge = aided_ && missing_gyro_run_ < kMaxBridgedGyroReadings;
+  if (n_ > 0 && (verdict == GateVerdict::AcceptAfterGap || s.has_position() != positions_ ||
+                 (gyro_aided(s) != aided_ && !bridge))) {
     count = emit_pending(out);
     ++counters_.restarts;
   }
@@ -502,7 +505,7 @@ void FairingWindow::slide(int count) {
 
 bool FairingWindow::gyro_aided(const Sample& s) const {
   // A non-finite reading is no reading: it would poison the window and the estimates.
-  return config_.gyro.enabled && s.has_gyro() && s.gyro.allFinite() && config_.solver == WindowSolver::Linear &&
+  return config_.gyro.enabled && has_gyro_reading(s) && config_.solver == WindowSolver::Linear &&
          config_.horizon_s == 0.0;
 }
 
@@ -510,6 +513,13 @@ void FairingWindow::append(const Sample& s) {
   if (n_ == 0) {
     positions_ = s.has_position();
     aided_ = gyro_aided(s);
+    missing_gyro_run_ = 0;
+  }
+  if (aided_ && !gyro_aided(s)) {
+    ++missing_gyro_run_;
+    ++counters_.gyro_bridged;
+  } else {
+    missing_gyro_run_ = 0;
   }
   if (n_ == w_) slide(1);
   const auto k = static_cast<std::size_t>(n_);

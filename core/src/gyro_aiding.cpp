@@ -9,42 +9,77 @@ GyroAiding::GyroAiding(const GyroAidingSettings& settings)
     : settings_(settings), offset_(std::clamp(settings.time_offset_s, -settings.max_time_offset_s, settings.max_time_offset_s)) {}
 
 Vec3 GyroAiding::rate_at(std::span<const Sample> s, double t) const {
-  const auto n = s.size();
+  const std::size_t n = s.size();
+  // The samples around t: the last at or before it (the first, before the window), the next.
   std::size_t i = 0;
-  Vec3 raw;
-  if (t <= s[0].time) {
-    raw = s[0].gyro;
-  } else if (t >= s[n - 1].time) {
-    raw = s[n - 1].gyro;
-  } else {
-    // The reading at or before t (binary search: a window is at most a few hundred samples).
+  if (t >= s[n - 1].time) {
+    i = n - 1;
+  } else if (t > s[0].time) {
+    // Binary search: a window is at most a few hundred samples.
     i = static_cast<std::size_t>(std::upper_bound(s.begin(), s.end(), t, [](double v, const Sample& x) { return v < x.time; }) -
                                  s.begin()) - 1;
-    const double f = (t - s[i].time) / (s[i + 1].time - s[i].time);
-    raw = (1.0 - f) * s[i].gyro + f * s[i + 1].gyro;
+  }
+  const bool inside = t > s[0].time && t < s[n - 1].time;
+  // The readings around them: a missing one is bridged by its neighbours (at most
+  // kMaxBridgedGyroReadings in a row, so these walks are short).
+  std::size_t lo = i, hi = inside ? i + 1 : i;
+  while (lo > 0 && !has_gyro_reading(s[lo])) --lo;
+  while (hi + 1 < n && !has_gyro_reading(s[hi])) ++hi;
+  const bool have_lo = has_gyro_reading(s[lo]), have_hi = has_gyro_reading(s[hi]);
+  Vec3 raw = Vec3::Zero();
+  if (inside && have_lo && have_hi && lo < hi) {
+    const double f = (t - s[lo].time) / (s[hi].time - s[lo].time);
+    raw = (1.0 - f) * s[lo].gyro + f * s[hi].gyro;
+  } else if (have_lo && (t >= s[lo].time || !have_hi)) {
+    raw = s[lo].gyro;  // at or past the last reading: held
+  } else if (have_hi) {
+    raw = s[hi].gyro;  // before the first reading: held
   }
   return settings_.mounting * (raw - bias_);
 }
 
+Vec3 GyroAiding::interval_residual(std::span<const Sample> samples, const Vec3& zeta, std::size_t k,
+                                   Vec3* sensitivity) const {
+  const double t0 = samples[k].time, t1 = samples[k + 1].time;
+  const Vec3 w0 = rate_at(samples, t0 + offset_);
+  const Vec3 w1 = rate_at(samples, t1 + offset_);
+  *sensitivity = 0.5 * (w1 - w0);
+  return zeta - 0.25 * (t1 - t0) * (w0 + w1);  // trapezoid, half-angle
+}
+
 void GyroAiding::update(std::span<const Sample> samples, std::span<const Vec3> zeta, std::span<Vec3> residual) {
-  const int n = static_cast<int>(samples.size());
+  const std::size_t n = samples.size();
   if (n < 2) return;
-  const double newest = samples[static_cast<std::size_t>(n - 1)].time;
-  for (int j = n - 2; j >= 0; --j) {
-    const auto k = static_cast<std::size_t>(j);
-    const double t0 = samples[k].time, t1 = samples[k + 1].time;
-    const Vec3 w0 = rate_at(samples, t0 + offset_);
-    const Vec3 w1 = rate_at(samples, t1 + offset_);
-    const double dt = t1 - t0;
-    residual[k] = zeta[k] - 0.25 * dt * (w0 + w1);  // trapezoid, half-angle
-    if (t1 + offset_ <= newest) {
-      // Complete: its gyro support is in. Older intervals keep the residual they had then.
-      if (t1 > observed_until_) {
-        observe(residual[k], 0.5 * (w1 - w0), dt);
-        observed_until_ = t1;
-      }
-      break;
-    }
+  // An interval is complete once its gyro support ends at or before the newest reading.
+  std::size_t newest = n - 1;
+  while (newest > 0 && !has_gyro_reading(samples[newest])) --newest;
+  const double newest_reading = samples[newest].time;
+  // Back from the newest interval: the incomplete ones, and those this reading completed.
+  // Older intervals keep the residual they had when they were completed.
+  std::size_t first_completed = n - 1;  // none
+  std::size_t last_completed = n - 1;
+  bool seen_complete = false;
+  for (std::size_t k = n - 1; k-- > 0;) {
+    const double t1 = samples[k + 1].time;
+    const bool complete = t1 + offset_ <= newest_reading;
+    if (complete && seen_complete && t1 <= observed_until_) break;
+    Vec3 sensitivity;
+    residual[k] = interval_residual(samples, zeta[k], k, &sensitivity);
+    if (!complete) continue;
+    if (!seen_complete) last_completed = k;
+    seen_complete = true;
+    if (t1 <= observed_until_) break;
+    first_completed = k;
+  }
+  // The completed intervals to the estimates, oldest first (the bias's line runs forward in
+  // time). Bridged ones too: both estimates sum the orientation's jitter over consecutive
+  // intervals, where it telescopes; leaving an interval out would leave its jitter in for good
+  // (far more than the interpolated rate's error).
+  for (std::size_t k = first_completed; k <= last_completed && k + 1 < n; ++k) {
+    Vec3 sensitivity;
+    const Vec3 r = interval_residual(samples, zeta[k], k, &sensitivity);
+    observe(r, sensitivity, samples[k + 1].time - samples[k].time);
+    observed_until_ = samples[k + 1].time;
   }
 }
 

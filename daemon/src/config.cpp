@@ -1251,7 +1251,7 @@ class Parser {
       const DriverConfig& d = streams[j].driver;
       const std::string source = in_quotes(name) + " (" + element_key("stream", j) + ")";
       if (d.type == DriverType::Synthetic) fail(*given[i], "stream " + source + " has no gyroscope: a synthetic source makes orientations only");
-      if (d.type == DriverType::Replay && d.replay.candump.empty() && !drivers::is_sample_log(d.replay.path))
+      if (d.type == DriverType::Replay && d.replay.candump.empty() && !formats::is_sample_log_file(d.replay.path))
         fail(*given[i], "stream " + source + " has no gyroscope: it replays a pose file (" + d.replay.path.filename().string() +
                             "), which holds orientations only; a sample log holds readings");
       // Each stream names at most one source: follow the chain; coming back to i is a cycle.

@@ -7,8 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
-#include <cstdio>
-#include <cstring>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -30,19 +28,9 @@ double loop_period(double lo, double hi, std::size_t n) {
 
 }  // namespace
 
-bool is_sample_log(const std::filesystem::path& path) {
-  if (path.extension() == ".pflog") return true;
-  std::FILE* f = std::fopen(path.c_str(), "rbe");
-  if (f == nullptr) return false;
-  unsigned char head[sizeof formats::kSampleLogMagic] = {};
-  const std::size_t n = std::fread(head, 1, sizeof head, f);
-  std::fclose(f);
-  return n == sizeof head && std::memcmp(head, formats::kSampleLogMagic, sizeof head) == 0;
-}
-
 ReplayDriver::ReplayDriver(const std::filesystem::path& source, ReplayOptions options)
     : options_(std::move(options)), name_("replay:" + source.filename().string()) {
-  if (is_sample_log(source)) {
+  if (formats::is_sample_log_file(source)) {
     formats::SampleLogContents log = options_.follow_rotation ? formats::read_sample_log_set(source) : formats::read_sample_log(source);
     samples_ = std::move(log.samples);
     streams_ = std::move(log.header.streams);

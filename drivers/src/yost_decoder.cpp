@@ -56,6 +56,22 @@
 //    device_time = unwrapped µs · 1e-6 s, with kHasDeviceTime. reset() forgets the rollover.
 //  - yost_data_length > 16 allows further streaming slots after slot 0 (which must be command
 //    0x00); their bytes are covered by the checksum and otherwise skipped.
+//  - Raw readings (issue 17): yost_slots names the streaming slots (command 80) in order; of the
+//    slots after the quaternion these are read, their sizes and units from Yost's Python API
+//    (command table: 0x25 '>9f', 0x26..0x28 '>fff') and its docstrings ("the gyro vector is in
+//    units of radians/sec, the accelerometer vector is in units of G, and the compass vector is
+//    in units of gauss"; the accelerometer "will include the static component of acceleration
+//    due to gravity"):
+//      0x25 getAllCorrectedComponentSensorData  gyro rad/s, accel g, compass gauss (9 f32 BE)
+//      0x26 getCorrectedGyroRate                gyro rad/s (3 f32 BE)
+//      0x27 getCorrectedAccelerometerVector     accel g
+//      0x28 getCorrectedCompassVector           compass gauss
+//    -> gyro (kHasGyro), accel · 9.80665 m/s² (kHasAccel), compass · 100 µT (kHasMag), in the
+//    sensor's axes (those of command 116, like the quaternion). Not read: the "raw" commands
+//    0x40..0x43 (counts "dependent on the currently selected range", not a physical unit) and
+//    the "normalized" 0x20..0x23 (unit vectors: the accelerometer's magnitude is gone). A slot
+//    after an unknown command (its size is unknown to the decoder) cannot be read: refused. A
+//    packet whose readings are not finite counts as malformed.
 //
 // Conventions. posefair's sample q rotates sensor coordinates into world coordinates. The
 // decoder takes the four floats as x, y, z, w and passes the quaternion on unchanged (no
@@ -76,6 +92,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "posefair/drivers/byte_order.hpp"
 #include "posefair/drivers/checksums.hpp"
@@ -90,6 +107,31 @@ constexpr std::size_t kMaxHeader = 1 + 4 + 1 + 1 + 1 + 4 + 1;
 constexpr std::size_t kMaxPacket = kMaxHeader + 255;
 constexpr std::uint32_t kRequiredBits = kYostSuccess | kYostChecksum | kYostDataLength;
 constexpr std::uint32_t kAllBits = 0x7F;
+constexpr double kStandardGravity = 9.80665;  // m/s² per g
+constexpr double kMicroteslaPerGauss = 100.0;
+constexpr std::size_t kMaxSlots = 8;  // command 80 takes eight slot bytes
+constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+
+// A streaming slot command the decoder can read, and what its data holds.
+struct SlotCommand {
+  std::uint8_t command;
+  std::size_t bytes;
+  bool gyro, accel, mag;  // in this order
+};
+constexpr SlotCommand kSlotCommands[] = {
+    {0x00, kQuaternionBytes, false, false, false},  // getTaredOrientationAsQuaternion
+    {0x25, 36, true, true, true},                   // getAllCorrectedComponentSensorData
+    {0x26, 12, true, false, false},                 // getCorrectedGyroRate
+    {0x27, 12, false, true, false},                 // getCorrectedAccelerometerVector
+    {0x28, 12, false, false, true},                 // getCorrectedCompassVector
+};
+
+// Where each raw reading sits in a packet's data (kNone: not streamed), and the data bytes the
+// slots take.
+struct SlotLayout {
+  std::size_t gyro = kNone, accel = kNone, mag = kNone;
+  std::size_t bytes = kQuaternionBytes;
+};
 
 struct Layout {
   std::size_t success = 0, timestamp = 0, echo = 0, checksum = 0, logical_id = 0, serial_number = 0, length = 0;
@@ -130,10 +172,48 @@ bool parse_unsigned(std::string_view s, std::uint32_t& out) {
   return ec == std::errc() && ptr == s.data() + s.size();
 }
 
+// yost_slots: slot commands separated by commas, e.g. "0x00,0x25"; throws OptionError.
+SlotLayout parse_slots(const std::string& text) {
+  const auto refuse = [&](const std::string& why) {
+    throw OptionError("yost_slots", why + " (a list of the streaming slot commands, e.g. \"0x00,0x25\"; readable after "
+                                          "0x00: 0x25, 0x26, 0x27, 0x28), got \"" + text + "\"");
+  };
+  SlotLayout out;
+  out.bytes = 0;
+  std::size_t count = 0;
+  std::string_view rest = text;
+  while (true) {
+    const std::size_t comma = rest.find(',');
+    std::string_view item = rest.substr(0, comma);
+    while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
+    while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
+    std::uint32_t command = 0;
+    if (!parse_unsigned(item, command)) refuse("not a command number: \"" + std::string(item) + "\"");
+    if (++count > kMaxSlots) refuse("more than 8 slots");
+    if (count == 1 && command != 0x00) refuse("slot 0 must be the tared quaternion, 0x00");
+    const SlotCommand* known = nullptr;
+    for (const SlotCommand& c : kSlotCommands)
+      if (c.command == command && (count == 1 || command != 0x00)) known = &c;
+    if (known == nullptr) refuse("slot " + std::to_string(count - 1) + ": command " + std::string(item) + " cannot be read");
+    std::size_t at = out.bytes;
+    for (auto [wanted, slot] : {std::pair{known->gyro, &out.gyro}, std::pair{known->accel, &out.accel},
+                                std::pair{known->mag, &out.mag}}) {
+      if (!wanted) continue;
+      if (*slot != kNone) refuse("slot " + std::to_string(count - 1) + " repeats a reading an earlier slot gives");
+      *slot = at;
+      at += 12;
+    }
+    out.bytes += known->bytes;
+    if (comma == std::string_view::npos) break;
+    rest.remove_prefix(comma + 1);
+  }
+  return out;
+}
+
 class YostDecoder final : public Decoder {
  public:
-  YostDecoder(std::uint32_t bits, std::size_t data_length)
-      : l_(layout_of(bits)), data_length_(data_length), packet_size_(l_.header_size + data_length) {}
+  YostDecoder(std::uint32_t bits, std::size_t data_length, const SlotLayout& slots)
+      : l_(layout_of(bits)), data_length_(data_length), packet_size_(l_.header_size + data_length), slots_(slots) {}
 
   std::string_view protocol() const override { return "yost"; }
 
@@ -217,6 +297,12 @@ class YostDecoder final : public Decoder {
     q.coeffs() /= norm;
     DecodedSample sample;
     sample.orientation = q;
+    if (!read_vector(data, slots_.gyro, 1.0, kHasGyro, sample.gyro, sample.flags) ||
+        !read_vector(data, slots_.accel, kStandardGravity, kHasAccel, sample.accel, sample.flags) ||
+        !read_vector(data, slots_.mag, kMicroteslaPerGauss, kHasMag, sample.mag, sample.flags)) {
+      ++counters_.malformed;
+      return true;
+    }
     if (l_.has_timestamp) {
       sample.device_time = static_cast<double>(unwrap(bytes::be_u32(p + l_.timestamp))) * 1e-6;
       sample.flags |= kHasDeviceTime;
@@ -224,6 +310,15 @@ class YostDecoder final : public Decoder {
     ++counters_.samples;
     sink.on_sample(sample);
     return true;
+  }
+
+  // Three big-endian floats at data + at, scaled, with their flag; false when not finite.
+  static bool read_vector(const std::uint8_t* data, std::size_t at, double scale, std::uint32_t flag, Vec3& out,
+                          std::uint32_t& flags) {
+    if (at == kNone) return true;
+    out = scale * Vec3(bytes::be_f32(data + at), bytes::be_f32(data + at + 4), bytes::be_f32(data + at + 8));
+    flags |= flag;
+    return out.allFinite();
   }
 
   std::uint64_t unwrap(std::uint32_t raw) {
@@ -237,6 +332,7 @@ class YostDecoder final : public Decoder {
   const Layout l_;
   const std::size_t data_length_;
   const std::size_t packet_size_;
+  const SlotLayout slots_;
   std::array<std::uint8_t, 2 * kMaxPacket> work_{};  // [0, pending_): bytes kept from the last feed
   std::size_t pending_ = 0;
   bool have_timestamp_ = false;
@@ -251,11 +347,14 @@ constexpr OptionSpec kOptions[] = {
     {"yost_header", OptionType::IntegerOrString, "0x4F",
      "the wired response header bitfield set with command 221; needs success 0x01, checksum 0x08, data length 0x40"},
     {"yost_data_length", OptionType::IntegerOrString, "16",
-     "data bytes per streamed packet (16..255); slot 0 must be the tared quaternion, later bytes are skipped"},
+     "data bytes per streamed packet (16..255; default: what yost_slots takes); bytes after the slots read are skipped"},
+    {"yost_slots", OptionType::String, "0x00",
+     "the streaming slot commands (command 80) in order, slot 0 = 0x00; 0x25 (corrected gyro, accel, compass), "
+     "0x26 (gyro), 0x27 (accel), 0x28 (compass) after it are read as raw readings"},
 };
 }  // namespace
 
-const DecoderEntry kYostDecoder{"yost", "Yost Labs 3-Space: streamed tared quaternion with the wired response header",
+const DecoderEntry kYostDecoder{"yost", "Yost Labs 3-Space: streamed tared quaternion (and corrected gyro, accel, compass) with the wired response header",
                                 kOptions, make_yost_decoder};
 
 std::unique_ptr<Decoder> make_yost_decoder(const OptionMap& options) {
@@ -267,10 +366,25 @@ std::unique_ptr<Decoder> make_yost_decoder(const OptionMap& options) {
     throw OptionError("yost_header",
                       "expected the command-221 bitfield (e.g. \"0x4F\") with success 0x01, checksum 0x08 and "
                       "data length 0x40 and no bit above 0x40, got \"" + header + "\"");
+  const SlotLayout slots = parse_slots(read.text("yost_slots"));
   std::uint32_t length = 0;
-  if (!parse_unsigned(data_length, length) || length < kQuaternionBytes || length > 255)
+  if (!read.has("yost_data_length")) {
+    length = static_cast<std::uint32_t>(slots.bytes);
+  } else if (!parse_unsigned(data_length, length) || length < kQuaternionBytes || length > 255) {
     throw OptionError("yost_data_length", "expected 16..255 (bytes per streamed packet), got \"" + data_length + "\"");
-  return std::make_unique<YostDecoder>(bits, length);
+  }
+  if (length < slots.bytes)
+    throw OptionError("yost_data_length", "the slots of yost_slots take " + std::to_string(slots.bytes) +
+                                              " bytes, more than " + data_length);
+  return std::make_unique<YostDecoder>(bits, length, slots);
+}
+
+std::vector<std::uint8_t> encode_yost_vectors(std::initializer_list<Vec3> vectors) {
+  std::vector<std::uint8_t> out(12 * vectors.size());
+  std::uint8_t* p = out.data();
+  for (const Vec3& v : vectors)
+    for (int i = 0; i < 3; ++i, p += 4) bytes::put_be_f32(p, static_cast<float>(v[i]));
+  return out;
 }
 
 std::vector<std::uint8_t> encode_yost_quaternion_packet(const Quat& q, std::uint32_t timestamp_us,

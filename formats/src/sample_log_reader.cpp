@@ -283,6 +283,16 @@ bool SampleLogReader::next(Sample& out) {
 
 // ---------------------------------------------------------------------------------------------
 
+bool is_sample_log_file(const std::filesystem::path& path) {
+  if (path.extension() == ".pflog") return true;
+  std::FILE* f = std::fopen(path.c_str(), "rbe");
+  if (f == nullptr) return false;
+  unsigned char head[sizeof kSampleLogMagic] = {};
+  const std::size_t n = std::fread(head, 1, sizeof head, f);
+  std::fclose(f);
+  return n == sizeof head && std::memcmp(head, kSampleLogMagic, sizeof head) == 0;
+}
+
 SampleLogContents read_sample_log(const std::filesystem::path& path) {
   SampleLogReader reader(path);
   SampleLogContents out;

@@ -14,6 +14,7 @@
 #include <iostream>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "posefair/core/euler_angles.hpp"
@@ -127,7 +128,9 @@ struct Device {
   std::function<std::string(std::size_t, const Motion&)> frame;  // the device's bytes for one sample
 };
 
-void write_log(const Device& d, const std::vector<Motion>& motion, const std::string& source, const std::string& dir) {
+// `options`: the decoder options the log needs, written as "# option.<key>: <value>".
+void write_log(const Device& d, const std::vector<Motion>& motion, const std::string& source, const std::string& dir,
+               const std::vector<std::pair<std::string, std::string>>& options = {}) {
   std::mt19937 rng(d.seed);
   const auto pick = [&](std::size_t n) { return static_cast<std::size_t>(rng() % n); };
   std::string data;
@@ -172,6 +175,7 @@ void write_log(const Device& d, const std::vector<Motion>& motion, const std::st
       << "# protocol: " << d.protocol << "\n"
       << "# baud: " << d.baud << "\n"
       << "# rate: " << rate << "\n";
+  for (const auto& [key, value] : options) out << "# option." << key << ": " << value << "\n";
   out << "# source: " << source << ", every " << kStride << "rd row from the first, " << motion.size()
       << " frames (BROAD trial 07, CC BY 4.0, see data/demo/SOURCE.md)\n"
       << "# made: make_replay_logs (tests/replay/make_replay_logs.cpp), seed " << d.seed
@@ -251,6 +255,19 @@ int main(int argc, char** argv) {
          }},
     };
     for (const Device& d : devices) write_log(d, motion, "data/demo/broad-07-excerpt.csv", argv[2]);
+    // A Yost streaming its corrected sensor data in slot 1 (yost_slots): the excerpt's gyroscope,
+    // gravity in g and an earth field (0, 20, -40) µT (ENU) in gauss, at the orientation.
+    const Device yost_imu{
+        "yost-3space-imu",
+        "Yost Labs 3-Space: slot 0 = tared quaternion, slot 1 = corrected gyro, accelerometer and compass (0x25), "
+        "header 0x4F",
+        "yost", 115200, 19, [&](std::size_t, const Motion& m) {
+          drv::YostPacketFields f;
+          f.extra = drv::encode_yost_vectors(
+              {m.gyro, m.accel / 9.80665, m.q.conjugate() * Vec3(0.0, 0.20, -0.40)});
+          return text(drv::encode_yost_quaternion_packet(m.q, us(m.t, near_wrap), f));
+        }};
+    write_log(yost_imu, motion, "data/demo/broad-07-excerpt.csv", argv[2], {{"yost_slots", "0x00,0x25"}});
   } catch (const std::exception& e) {
     std::cerr << "make_replay_logs: " << e.what() << "\n";
     return 1;

@@ -89,6 +89,9 @@ std::string run_through_pty(const posefair::replay::ReplayLog& log, drv::Decoder
   o.port.device = pty.slave();
   o.settings.baud = std::stoi(log.header.at("baud"));
   o.protocol = log.header.at("protocol");
+  // "# option.<key>: <value>" lines: the decoder's options, as a config's string values.
+  for (const auto& [key, value] : log.header)
+    if (key.rfind("option.", 0) == 0) o.decoder_options[key.substr(7)] = value;
   o.reconnect_min = 0.01;
   o.reconnect_max = 0.05;
   drv::SerialDriver driver(std::move(o));

@@ -8,7 +8,7 @@
 namespace posefair::replay {
 
 struct ReplayLog {
-  std::map<std::string, std::string> header;  // device, protocol, baud, rate, source, made, faults, option.*
+  std::map<std::string, std::string> header;  // device, protocol, baud, rate, source, made, faults, option.<key>
   std::string data;                           // the raw bytes as the device sent them
 };
 

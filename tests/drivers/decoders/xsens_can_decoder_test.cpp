@@ -1,11 +1,14 @@
 // The Xsens MTi CAN decoder (drivers/src/xsens_can_decoder.cpp): documented values, pairing of
-// SampleTime and GroupCounter with the quaternion, round trips through encode_xsens_can,
-// malformed frames, rollover, identifiers and options, and 10 MB of random frames.
+// SampleTime and GroupCounter with the quaternion, raw readings gathered per group, round trips
+// through encode_xsens_can, malformed frames, rollover, identifiers and options, and 10 MB of
+// random frames.
 //
 // Byte-exact examples: none of the Xsens documents found shows a captured CAN frame. The
 // frames below follow the documented layout (MT1604P / Movella "CAN Messages": XCDI_Quaternion
 // 0x021, four int16 big-endian; 1.0 is 0x7FFF, -1.0 is 0x8001, the page's "be careful when
-// converting the value 1"; XCID_SampleTime 0x005 uint32; XCID_GroupCounter 0x006 uint16).
+// converting the value 1"; XCID_SampleTime 0x005 uint32; XCID_GroupCounter 0x006 uint16;
+// XCDI_RateOfTurn 0x032, XCDI_Acceleration 0x034, XCDI_MagneticField 0x041: three int16
+// big-endian each, scaled 2^-9 rad/s, 2^-8 m/s², 2^-10 a.u.).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -99,6 +102,130 @@ TEST(XsensCanDecoder, QuaternionIsSensorToEarth) {
   const CanDecoded r = decode(encode_xsens_can(Quat(h, 0, 0, h), std::nullopt, std::nullopt));
   ASSERT_EQ(r.samples.size(), 1u);
   EXPECT_NEAR((r.samples[0].orientation * Vec3::UnitX()).y(), 1.0, 1e-4);
+}
+
+OptionMap raw_options(std::vector<std::string> kinds = {"rate_of_turn", "acceleration", "magnetic_field"}) {
+  OptionMap o;
+  o["xsens_raw"] = std::move(kinds);
+  return o;
+}
+
+// One group: SampleTime 1000 ticks, identity, rate of turn (1, -1, 0.25) rad/s, acceleration
+// (0, 0, 9.80859375) m/s², magnetic field (0.25, 0, -0.25) a.u.
+const std::vector<CanFrame> kRawGroup = {
+    frame(0x005, "00 00 03 E8"),
+    frame(0x021, "7F FF 00 00 00 00 00 00"),
+    frame(0x032, "02 00 FE 00 00 80"),  // 512, -512, 128 · 2^-9
+    frame(0x034, "00 00 00 00 09 CF"),  // 2511 · 2^-8 = 9.80859375
+    frame(0x041, "01 00 00 00 FF 00"),  // 256, 0, -256 · 2^-10
+};
+
+TEST(XsensCanRaw, DocumentedValuesDecodeAndTheGroupIsEmittedAtItsLastMessage) {
+  auto d = make_xsens_can_decoder(raw_options());
+  Collector c;
+  for (std::size_t k = 0; k + 1 < kRawGroup.size(); ++k) d->feed(kRawGroup[k], c);
+  EXPECT_TRUE(c.samples.empty());  // the magnetic field is still to come
+  d->feed(kRawGroup.back(), c);
+  ASSERT_EQ(c.samples.size(), 1u);
+  const DecodedSample& s = c.samples[0];
+  EXPECT_EQ(s.flags, static_cast<std::uint32_t>(kHasDeviceTime | kHasGyro | kHasAccel | kHasMag));
+  EXPECT_EQ(s.orientation.coeffs(), Quat::Identity().coeffs());
+  EXPECT_EQ(s.gyro, Vec3(1.0, -1.0, 0.25));
+  EXPECT_EQ(s.accel, Vec3(0.0, 0.0, 9.80859375));
+  EXPECT_EQ(s.mag, Vec3(12.5, 0.0, -12.5));  // a.u. · 50 µT (xsens_mag_field's default)
+  EXPECT_DOUBLE_EQ(s.device_time, 0.1);
+  // The encoder writes these frames.
+  std::vector<CanFrame> encoded = encode_xsens_can(Quat::Identity(), 1000, std::nullopt);
+  const std::vector<CanFrame> raw = encode_xsens_can_raw(Vec3(1.0, -1.0, 0.25), Vec3(0.0, 0.0, 9.80859375), Vec3(0.25, 0.0, -0.25));
+  encoded.insert(encoded.end(), raw.begin(), raw.end());
+  ASSERT_EQ(encoded.size(), kRawGroup.size());
+  for (std::size_t k = 0; k < encoded.size(); ++k) {
+    EXPECT_EQ(encoded[k].id(), kRawGroup[k].id()) << k;
+    EXPECT_EQ(std::vector<std::uint8_t>(encoded[k].data.begin(), encoded[k].data.begin() + encoded[k].len),
+              std::vector<std::uint8_t>(kRawGroup[k].data.begin(), kRawGroup[k].data.begin() + kRawGroup[k].len)) << k;
+  }
+  // Only the listed messages are read: with the magnetic field left out the group ends at the
+  // acceleration, and the field's frame is foreign.
+  OptionMap two = raw_options({"rate_of_turn", "acceleration"});
+  two["xsens_mag_field"] = 48.0;
+  const CanDecoded r = decode(kRawGroup, two);
+  ASSERT_EQ(r.samples.size(), 1u);
+  EXPECT_EQ(r.samples[0].flags, static_cast<std::uint32_t>(kHasDeviceTime | kHasGyro | kHasAccel));
+  EXPECT_EQ(r.frame_counters.foreign, 1u);
+}
+
+TEST(XsensCanRaw, ALostFrameCostsOnlyItsReading) {
+  std::vector<CanFrame> stream;
+  const auto group = [&](std::uint32_t time, bool quaternion, bool acceleration) {
+    stream.push_back(frame(0x005, "00 00 00 00"));
+    stream.back().data[3] = static_cast<std::uint8_t>(time);
+    if (quaternion) stream.push_back(kRawGroup[1]);
+    stream.push_back(kRawGroup[2]);
+    if (acceleration) stream.push_back(kRawGroup[3]);
+    stream.push_back(kRawGroup[4]);
+  };
+  group(1, true, true);
+  group(2, true, false);   // its acceleration lost: emitted when group 3 starts, without it
+  group(3, false, true);   // its quaternion lost: a raw-only sample
+  group(4, true, true);
+  const CanDecoded r = decode(stream, raw_options());
+  ASSERT_EQ(r.samples.size(), 4u);
+  EXPECT_EQ(r.samples[1].flags, static_cast<std::uint32_t>(kHasDeviceTime | kHasGyro | kHasMag));
+  EXPECT_EQ(r.samples[2].flags, static_cast<std::uint32_t>(kHasDeviceTime | kHasGyro | kHasAccel | kHasMag | kNoOrientation));
+  for (std::size_t k = 0; k < 4; ++k) EXPECT_DOUBLE_EQ(r.samples[k].device_time, 1e-4 * static_cast<double>(k + 1)) << k;
+  EXPECT_EQ(r.samples[3].flags, static_cast<std::uint32_t>(kHasDeviceTime | kHasGyro | kHasAccel | kHasMag));
+  EXPECT_EQ(r.counters.samples, 4u);
+  EXPECT_EQ(r.counters.malformed, 0u);
+  // A raw frame of the wrong size is malformed and the group goes on without it.
+  std::vector<CanFrame> bad = kRawGroup;
+  bad[2] = frame(0x032, "02 00 FE 00 00");
+  const CanDecoded m = decode(bad, raw_options({"rate_of_turn", "acceleration"}));
+  EXPECT_EQ(m.counters.malformed, 1u);
+  EXPECT_EQ(m.samples.size(), 0u);  // waiting for its rate of turn until the next group starts
+}
+
+TEST(XsensCanRaw, RoundTripsRandomReadings) {
+  std::mt19937_64 rng(12);
+  std::normal_distribution<double> n;
+  std::vector<CanFrame> stream;
+  std::vector<std::array<Vec3, 3>> truth;
+  for (int k = 0; k < 200; ++k) {
+    const std::array<Vec3, 3> v = {Vec3(n(rng), n(rng), n(rng)) * 5.0, Vec3(n(rng), n(rng), n(rng)) * 20.0,
+                                   Vec3(n(rng), n(rng), n(rng)) * 0.5};
+    truth.push_back(v);
+    const auto q = encode_xsens_can(random_unit_quaternion(rng), 100u * static_cast<std::uint32_t>(k), static_cast<std::uint16_t>(k));
+    const auto raw = encode_xsens_can_raw(v[0], v[1], v[2]);
+    stream.insert(stream.end(), q.begin(), q.end());
+    stream.insert(stream.end(), raw.begin(), raw.end());
+  }
+  const CanDecoded r = decode(stream, raw_options());
+  ASSERT_EQ(r.samples.size(), truth.size());
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    EXPECT_LT((r.samples[k].gyro - truth[k][0]).cwiseAbs().maxCoeff(), 0.5 / 512 + 1e-12) << k;  // half a step
+    EXPECT_LT((r.samples[k].accel - truth[k][1]).cwiseAbs().maxCoeff(), 0.5 / 256 + 1e-12) << k;
+    EXPECT_LT((r.samples[k].mag - 50.0 * truth[k][2]).cwiseAbs().maxCoeff(), 50.0 * 0.5 / 1024 + 1e-12) << k;
+    EXPECT_EQ(r.samples[k].frame_counter, k);
+  }
+  expect_filters_pass(make_xsens_can_decoder(raw_options())->filters(), stream, {0x022, 0x035, 0x061});
+}
+
+TEST(XsensCanRaw, OptionsAreChecked) {
+  EXPECT_THROW(make_xsens_can_decoder(raw_options({"gyro"})), std::invalid_argument);
+  EXPECT_THROW(make_xsens_can_decoder(raw_options({"acceleration", "acceleration"})), std::invalid_argument);
+  OptionMap o = raw_options();
+  o["xsens_acceleration_id"] = std::string("0x021");  // the quaternion's
+  try {
+    make_xsens_can_decoder(o);
+    ADD_FAILURE() << "accepted an identifier used twice";
+  } catch (const OptionError& e) {
+    EXPECT_EQ(e.key(), "xsens_acceleration_id");
+  }
+  o = raw_options({"rate_of_turn"});
+  o["xsens_acceleration_id"] = std::string("0x021");  // not listed: not read, so no clash
+  EXPECT_NE(make_xsens_can_decoder(o), nullptr);
+  o = raw_options();
+  o["xsens_mag_field"] = 0.0;
+  EXPECT_THROW(make_xsens_can_decoder(o), std::invalid_argument);
 }
 
 TEST(XsensCanDecoder, MalformedFramesAreCounted) {

@@ -1,6 +1,7 @@
 // Yost 3-Space decoder: byte layout against hand-written packets, component order, every header
-// variant, encode→decode round trips, timestamp rollover, chunking, resync, bad checksums,
-// failure and malformed packets, options, and random input.
+// variant, encode→decode round trips, raw readings from the corrected-data slots, timestamp
+// rollover, chunking, resync, bad checksums, failure and malformed packets, options, and random
+// input.
 //
 // No byte-exact example packet was found in Yost's documents or libraries (the manual's text
 // could not be retrieved; Yost's example scripts only unpack headers with struct ">cIcc"). The
@@ -136,6 +137,103 @@ TEST(YostRoundTrip, FurtherStreamingSlotsAreSkipped) {
   EXPECT_LT(so3::rotation_angle(r.samples[1].orientation, q), 1e-7);
   // The default (16 data bytes) does not take these packets.
   EXPECT_EQ(decode(packet(q, 1, f)).counters.frames, 0u);
+}
+
+// Slots 0x00 and 0x25 (getAllCorrectedComponentSensorData: gyro rad/s, accel g, compass
+// gauss, nine big-endian floats): identity; gyro (1, -2, 0.5); accel (0, 0, 1) g; compass
+// (0.25, 0, -0.5) gauss. Data length 16 + 36 = 0x34; checksum 0xBF + (0xBF + 0xC0 + 0x3F)
+// + 0xBF + (0xBE + 0xBF) = 1209 = 0xB9 mod 256.
+const Bytes kWithSensorData = {0x00, 0x00, 0x00, 0x00, 0x10, 0xFF, 0xB9, 0x34,  // header, ts 16 µs
+                               0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,  // x, y
+                               0x00, 0x00, 0x00, 0x00, 0x3F, 0x80, 0x00, 0x00,  // z, w
+                               0x3F, 0x80, 0x00, 0x00, 0xC0, 0x00, 0x00, 0x00, 0x3F, 0x00, 0x00, 0x00,  // gyro
+                               0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x3F, 0x80, 0x00, 0x00,  // accel
+                               0x3E, 0x80, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xBF, 0x00, 0x00, 0x00};  // compass
+
+OptionMap slots(const std::string& list) {
+  OptionMap o;
+  o["yost_slots"] = list;
+  return o;
+}
+
+Bytes vectors(std::initializer_list<Vec3> vs) { return encode_yost_vectors(vs); }
+
+TEST(YostRawReadings, TheCorrectedSensorDataSlotGivesGyroAccelAndCompassInSIUnits) {
+  const Decoded r = decode_with(kWithSensorData, slots("0x00,0x25"));
+  ASSERT_EQ(r.samples.size(), 1u);
+  const DecodedSample& s = r.samples[0];
+  EXPECT_EQ(s.flags, static_cast<std::uint32_t>(kHasDeviceTime | kHasGyro | kHasAccel | kHasMag));
+  EXPECT_EQ(s.orientation.coeffs(), Quat::Identity().coeffs());
+  EXPECT_EQ(s.gyro, Vec3(1.0, -2.0, 0.5));
+  EXPECT_EQ(s.accel, Vec3(0.0, 0.0, 9.80665));
+  EXPECT_EQ(s.mag, Vec3(25.0, 0.0, -50.0));
+  EXPECT_DOUBLE_EQ(s.device_time, 16e-6);
+  // The encoder writes the same bytes; without yost_slots the packet's 52 data bytes do not fit.
+  YostPacketFields f;
+  f.extra = vectors({{1.0, -2.0, 0.5}, {0.0, 0.0, 1.0}, {0.25, 0.0, -0.5}});
+  EXPECT_EQ(packet(Quat::Identity(), 16, f), kWithSensorData);
+  EXPECT_EQ(decode(kWithSensorData).counters.frames, 0u);
+  // With the length given and the slots not, the readings are skipped as before.
+  OptionMap skip;
+  skip["yost_data_length"] = std::string("52");
+  const Decoded skipped = decode_with(kWithSensorData, skip);
+  ASSERT_EQ(skipped.samples.size(), 1u);
+  EXPECT_EQ(skipped.samples[0].flags, static_cast<std::uint32_t>(kHasDeviceTime));
+}
+
+TEST(YostRawReadings, SingleSlotsInAnyOrderWithSlotsAfterThemSkipped) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> n01;
+  OptionMap o = slots("0x00, 0x28, 0x26");  // compass, then gyro; no accelerometer
+  o["yost_data_length"] = std::string("44");  // a further 4-byte slot (e.g. temperature, 0x2B) skipped
+  Bytes stream;
+  std::vector<std::pair<Vec3, Vec3>> truth;
+  for (int k = 0; k < 50; ++k) {
+    const Vec3 compass(n01(rng), n01(rng), n01(rng)), gyro(n01(rng), n01(rng), n01(rng));
+    truth.emplace_back(compass, gyro);
+    YostPacketFields f;
+    f.extra = vectors({compass, gyro});
+    f.extra.insert(f.extra.end(), {0x41, 0xC8, 0x00, 0x00});
+    stream = stream + packet(Quat::Identity(), static_cast<std::uint32_t>(k), f);
+  }
+  const Decoded r = decode(stream, {7, 13, 1, 29}, o);
+  ASSERT_EQ(r.samples.size(), truth.size());
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    EXPECT_EQ(r.samples[k].flags, static_cast<std::uint32_t>(kHasDeviceTime | kHasGyro | kHasMag));
+    EXPECT_LT((r.samples[k].mag - 100.0 * truth[k].first).norm(), 1e-4) << k;  // µT; float precision
+    EXPECT_LT((r.samples[k].gyro - truth[k].second).norm(), 1e-6) << k;
+  }
+}
+
+TEST(YostRawReadings, ANonFiniteReadingMakesThePacketMalformed) {
+  YostPacketFields f;
+  f.extra = vectors({{0.0, std::nan(""), 0.0}});
+  const Bytes bad = packet(Quat::Identity(), 1, f);
+  f.extra = vectors({{0.0, 0.0, 1.0}});
+  const Bytes good = packet(Quat::Identity(), 2, f);
+  const Decoded r = decode_with(bad + good, slots("0x00,0x27"));
+  EXPECT_EQ(r.counters.frames, 2u);
+  EXPECT_EQ(r.counters.malformed, 1u);
+  ASSERT_EQ(r.samples.size(), 1u);
+  EXPECT_EQ(r.samples[0].accel, Vec3(0.0, 0.0, 9.80665));
+}
+
+TEST(YostOptions, SlotsAreValidated) {
+  EXPECT_NE(make_yost_decoder(slots("0x00")), nullptr);
+  EXPECT_NE(make_yost_decoder(slots("0,37")), nullptr);  // decimal: 37 = 0x25
+  EXPECT_NE(make_yost_decoder(slots("0x00,0x26,0x27,0x28")), nullptr);
+  for (const char* bad : {"", "0x25", "0x00,0x40", "0x00,0x21", "0x00,0x00", "0x00,0x25,0x26", "0x00,,0x26",
+                          "0x00,0x26,0x26", "0x00,zz"}) {
+    try {
+      make_yost_decoder(slots(bad));
+      ADD_FAILURE() << "accepted \"" << bad << "\"";
+    } catch (const OptionError& e) {
+      EXPECT_EQ(e.key(), "yost_slots") << bad;
+    }
+  }
+  OptionMap short_length = slots("0x00,0x25");
+  short_length["yost_data_length"] = std::string("40");
+  EXPECT_THROW(make_yost_decoder(short_length), std::invalid_argument);
 }
 
 TEST(YostTimestamp, RolloverIsUnwrapped) {
@@ -329,6 +427,19 @@ TEST(YostCorpus, SeedFilesDecodeAsIntended) {
   all["yost_header"] = std::string("0x7F");
   all["yost_data_length"] = std::string("20");
   EXPECT_EQ(decode_with(file("all_fields_len20.bin"), all).samples.size(), 12u);
+  // Slot 1 = 0x25: a turn about z at 0.5 rad/s, gravity 1 g, a field of 0.2 gauss horizontal
+  // and -0.4 gauss vertical turning with it.
+  const Decoded raw = decode_with(file("corrected_sensor_data.bin"), slots("0x00,0x25"));
+  ASSERT_EQ(raw.samples.size(), 10u);
+  EXPECT_EQ(raw.counters.skipped_bytes, 0u);
+  for (std::size_t k = 0; k < raw.samples.size(); ++k) {
+    const DecodedSample& s = raw.samples[k];
+    EXPECT_EQ(s.flags, static_cast<std::uint32_t>(kHasDeviceTime | kHasGyro | kHasAccel | kHasMag)) << k;
+    EXPECT_EQ(s.gyro, Vec3(0.0, 0.0, 0.5)) << k;
+    EXPECT_EQ(s.accel, Vec3(0.0, 0.0, 9.80665)) << k;
+    EXPECT_NEAR(Vec3(s.mag.x(), s.mag.y(), 0.0).norm(), 20.0, 1e-5) << k;
+    EXPECT_NEAR(s.mag.z(), -40.0, 1e-5) << k;
+  }
   const Decoded mixed = decode(file("mixed_garbage.bin"));
   EXPECT_EQ(mixed.samples.size(), 6u);
   EXPECT_EQ(mixed.counters.ignored_frames, 1u);

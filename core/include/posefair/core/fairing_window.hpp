@@ -69,7 +69,8 @@ struct WindowConfig {
   BoundPolicy bound = BoundPolicy::Sample;  // Window needs an iterative solver
   GateConfig gate;
   // Samples with a gyroscope reading (kHasGyro) put the smoothness on the orientation's angular
-  // velocity minus the gyro's (gyro_aiding.hpp); linear solver, no horizon.
+  // velocity minus the gyro's (gyro_aiding.hpp); linear solver, no horizon. Up to
+  // kMaxBridgedGyroReadings missing readings in a row are bridged; more restart the window.
   GyroAidingSettings gyro;
 };
 
@@ -95,7 +96,8 @@ double cutoff_for_smoothing(double mu, double rate_hz, int order);
 struct WindowCounters {
   std::uint64_t emitted = 0;
   std::uint64_t clamped = 0;    // emitted poses the ε projection had to move
-  std::uint64_t restarts = 0;   // windows restarted after a gap
+  std::uint64_t restarts = 0;   // windows restarted after a gap, or for samples with/without positions or gyro
+  std::uint64_t gyro_bridged = 0;  // readings missing from a gyro-aided window, bridged without a restart
 };
 
 // What the engine is doing now: the rate and window it settled on and, per channel, what the
@@ -178,7 +180,8 @@ class FairingWindow {
   int w_ = 0;              // W in use (capacity_ until the rate is known)
   int n_ = 0;              // samples in the window
   bool positions_ = false; // this window carries positions (all its samples do)
-  bool aided_ = false;     // this window is gyro-aided (all its samples carry a gyro)
+  bool aided_ = false;     // this window is gyro-aided (its samples carry a gyro, but for bridged gaps)
+  int missing_gyro_run_ = 0;  // readings missing in a row at the newest end of an aided window
   bool have_emitted_ = false;
   Quat last_emitted_ = Quat::Identity();
   double last_time_ = 0.0;

@@ -22,6 +22,15 @@
 //     relinearised at every interval, with forgetting time offset_time_s, applied once its
 //     standard error is below kOffsetResolution. The bias is estimated from then on, or after
 //     offset_time_s without one (before, each estimate's error would pass into the other).
+// A missing reading (a sample without kHasGyro, or with a non-finite one) inside a gyro-aided
+// window is bridged, up to kMaxBridgedGyroReadings in a row (FairingWindow restarts the window
+// after a longer outage): the rate is interpolated between the readings around it, so the
+// sample keeps its orientation data term and its intervals keep a residual of the same kind as
+// their neighbours'. Those intervals become complete only once the next reading is in; they
+// feed the estimates like the others (both sum the orientation's jitter over consecutive
+// intervals, where it telescopes: leaving one out would leave its jitter in for good, far more
+// than the interpolation's error). Why not drop the interval's gyro term instead: docs/fusion.md,
+// "A missing gyro reading".
 // No allocation: everything works on the window's own arrays.
 #include <cstdint>
 #include <span>
@@ -41,6 +50,12 @@ struct GyroAidingSettings {
   double offset_time_s = 20.0;          // forgetting time of the offset's least squares
 };
 
+// The most readings in a row a gyro-aided window bridges; one more restarts it.
+inline constexpr int kMaxBridgedGyroReadings = 2;
+
+// A gyro reading the window can use: present and finite (a NaN would poison the window).
+inline bool has_gyro_reading(const Sample& s) { return s.has_gyro() && s.gyro.allFinite(); }
+
 // The standard error (s) below which the estimated time offset is applied.
 inline constexpr double kOffsetResolution = 0.001;
 // Seconds of gyro-aided intervals before the bias estimate is applied.
@@ -59,19 +74,23 @@ class GyroAiding {
   explicit GyroAiding(const GyroAidingSettings& settings);
 
   // After a sample was appended to a gyro-aided window: samples holds the window's n samples
-  // (all with kHasGyro, times increasing), zeta their n−1 measured increments. Writes the
-  // residual increments of the intervals whose gyro support reaches past the newest sample
-  // (they are held at the newest reading until it arrives) and of the newest complete one, and
-  // feeds each complete interval once to the estimates.
+  // (times increasing; some with a reading, none more than kMaxBridgedGyroReadings in a row
+  // without), zeta their n−1 measured increments. Writes the residual increments of the
+  // intervals whose gyro support reaches past the newest reading (they are held at the newest
+  // reading until the next arrives) and of those completed by it, and feeds each completed
+  // interval once to the estimates, oldest first.
   void update(std::span<const Sample> samples, std::span<const Vec3> zeta, std::span<Vec3> residual);
 
   const GyroAidingSettings& settings() const { return settings_; }
   GyroAidingState state(bool active) const;
 
  private:
-  // The bias-corrected gyro rate in the body frame at time t, linear between readings and
-  // held beyond the window's ends.
+  // The bias-corrected gyro rate in the body frame at time t, linear between the readings
+  // around t (across samples without one) and held beyond the window's first and last reading.
   Vec3 rate_at(std::span<const Sample> samples, double t) const;
+  // The residual of interval k (samples k, k+1) and the sensitivity s of its gyro support, with
+  // the bias and offset in use now.
+  Vec3 interval_residual(std::span<const Sample> samples, const Vec3& zeta, std::size_t k, Vec3* sensitivity) const;
   void observe(const Vec3& residual, const Vec3& sensitivity, double dt);
   void observe_offset(const Vec3& residual, const Vec3& sensitivity, double dt);
 

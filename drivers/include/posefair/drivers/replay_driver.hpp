@@ -47,9 +47,8 @@ struct ReplayOptions {
   bool follow_rotation = true;
 };
 
-// A replay plays `path` as a sample log (named *.pflog, or starting with the log's magic),
-// else as a pose file.
-bool is_sample_log(const std::filesystem::path& path);
+// A replay plays a sample log (formats::is_sample_log_file: named *.pflog, or starting with the
+// log's magic) as such, anything else as a pose file.
 
 class ReplayDriver final : public Driver {
  public:

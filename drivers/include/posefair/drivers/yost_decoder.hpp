@@ -1,9 +1,11 @@
 #pragma once
 // Yost Labs 3-Space sensors: wired binary streaming of the tared orientation quaternion
-// (command 0x00) with the wired response header, registry name "yost". The decoder and the
+// (command 0x00), and optionally the corrected gyro, accelerometer and compass (commands
+// 0x25..0x28, option yost_slots), with the wired response header, registry name "yost". The decoder and the
 // packet encoder the tests, fuzz corpus and golden logs are built with. Conventions, quirks and
 // choices: drivers/src/yost_decoder.cpp.
 #include <cstdint>
+#include <initializer_list>
 #include <memory>
 #include <vector>
 
@@ -40,9 +42,14 @@ struct YostPacketFields {
   std::uint8_t command_echo = 0xFF;  // streamed packets echo 0xFF
   std::uint8_t logical_id = 0;
   std::uint32_t serial_number = 0;
-  std::vector<std::uint8_t> extra;   // data of further streaming slots, after the quaternion
+  std::vector<std::uint8_t> extra;   // data of further streaming slots, after the quaternion (encode_yost_vectors)
   int checksum_delta = 0;            // added to the correct checksum (tests of bad checksums)
 };
+
+// The data of the raw-reading slots (0x25: gyro, accel, compass; 0x26..0x28: one of them), for
+// YostPacketFields::extra: each vector as three big-endian IEEE floats, in the units the
+// sensor sends (rad/s, g, gauss).
+std::vector<std::uint8_t> encode_yost_vectors(std::initializer_list<Vec3> vectors);
 
 // One streamed packet: the header fields, then the quaternion as four big-endian IEEE floats
 // x, y, z, w (q as given: not normalised, sign kept), then fields.extra. The data length field

@@ -307,6 +307,11 @@ struct SampleLogContents {
   SampleLogStats stats;
 };
 
+// A sample log by its name (".pflog") or its first bytes (the magic); the test the replay
+// driver and posefair fuse use to tell a log from a pose or IMU file. Reads at most 8 bytes;
+// false for a file that cannot be opened (and is not named .pflog).
+bool is_sample_log_file(const std::filesystem::path& path);
+
 // The whole file: header errors throw SampleLogError; damage after the header does not throw
 // (stats.problems says where the intact part ends).
 SampleLogContents read_sample_log(const std::filesystem::path& path);
