@@ -179,17 +179,17 @@ struct Pipeline::Stream final : drivers::SampleSink {
   std::uint32_t index;
   std::unique_ptr<drivers::Driver> driver;
   std::string source;
-  FairingWindow window;                         // engine thread only
+  FairingWindow window;                         // engine role only
   SpscRing<RingSample> ring;                    // driver → engine
   SpscRing<RingPose> pose_ring;                 // engine → publisher
   std::unique_ptr<SpscRing<RingSample>> record_ring;  // driver → recorder
   std::vector<FairedPose> outputs;              // engine scratch
-  std::optional<GapBridge> bridge;              // engine thread only; [stream.spline] bridge_gap
+  std::optional<GapBridge> bridge;              // engine role only; [stream.spline] bridge_gap
   std::vector<Sample> bridged;                  // engine scratch
-  std::optional<FixedRateResampler> resampler;  // engine thread only; [stream.spline] publish_rate_hz
+  std::optional<FixedRateResampler> resampler;  // engine role only; [stream.spline] publish_rate_hz
   std::vector<FairedPose> grid;                 // engine scratch
-  std::optional<FusionStage> fusion;            // engine thread only; [stream.fusion]
-  std::optional<GyroPairing> gyro_pairing;      // engine thread only; [stream.engine] gyro_stream
+  std::optional<FusionStage> fusion;            // engine role only; [stream.fusion]
+  std::optional<GyroPairing> gyro_pairing;      // engine role only; [stream.engine] gyro_stream
   std::vector<GyroPairing*> gyro_consumers;     // the pairings this stream's gyroscope readings go to
   StreamCounters counters;
   MadeGpioLines gpio;                           // [stream.gpio]: data-ready sink (driver thread), output line
@@ -385,7 +385,7 @@ void Pipeline::stop(bool keep_recorder) {
   final_sequences_ = publisher_->next_sequences();
 }
 
-// Engine thread: a faired pose to the publisher as it is, or as the grid poses it completes
+// Engine role: a faired pose to the publisher as it is, or as the grid poses it completes
 // when the stream is resampled. True when anything was handed on.
 bool Pipeline::emit(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns) {
   if (!s.resampler) {
@@ -398,7 +398,7 @@ bool Pipeline::emit(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns
   return n > 0;
 }
 
-// Engine thread: a pose made, to the publisher's ring, or sent at once when the engine publishes.
+// Engine role: a pose made, to the publisher's ring, or sent at once when the engine publishes.
 // The first pose of a sample ends the sample's engine stage.
 void Pipeline::deliver(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns) {
   const std::uint64_t now = monotonic_ns();
@@ -426,7 +426,7 @@ void Pipeline::publish_pose(Stream& s, const RingPose& p, std::uint64_t popped_n
   stages_.send.record(res.send_ns);
 }
 
-// Engine thread: one sample into the window, its faired poses handed on.
+// Engine role: one sample into the window, its faired poses handed on.
 bool Pipeline::window_push(Stream& s, const Sample& sample, std::uint64_t enqueued_ns) {
   bool any = false;
   const int k = s.window.push(sample, s.outputs);
@@ -434,7 +434,7 @@ bool Pipeline::window_push(Stream& s, const Sample& sample, std::uint64_t enqueu
   return any;
 }
 
-// Engine thread: one sample from the driver, through the fusion stage and the gap bridge when
+// Engine role: one sample from the driver, through the fusion stage and the gap bridge when
 // the stream has them.
 bool Pipeline::fair(Stream& s, const Sample& raw, std::uint64_t enqueued_ns) {
   Sample sample = raw;
@@ -447,7 +447,7 @@ bool Pipeline::fair(Stream& s, const Sample& raw, std::uint64_t enqueued_ns) {
   return any;
 }
 
-// Engine thread, after the stream's driver ended and its ring is empty: the sample the bridge
+// Engine role, after the stream's driver ended and its ring is empty: the sample the bridge
 // holds, then the window's lagged tail.
 void Pipeline::flush_stream(Stream& s) {
   const std::uint64_t now = monotonic_ns();

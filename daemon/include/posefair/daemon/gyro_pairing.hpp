@@ -2,10 +2,11 @@
 // [stream.engine] gyro_stream (docs/fusion.md, "A gyroscope from another stream"): an
 // orientation stream gets its gyroscope readings from another stream on the same body, e.g. an
 // optical tracker at 120 Hz from an IMU at 1 kHz. Both streams' samples reach the engine thread
-// through their own SPSC rings; the engine thread adds each gyroscope reading of the source
-// here (add) and, before fairing each orientation sample of the paired stream, gives it the
-// source's angular velocity at its time (apply). Both run on the engine thread only, so the
-// readings are a plain fixed-size ring: no lock, no atomic, no allocation after construction.
+// through their own SPSC rings; the engine role's holder adds each gyroscope reading of the
+// source here (add) and, before fairing each orientation sample of the paired stream, gives it
+// the source's angular velocity at its time (apply). Both run under the engine role (one thread
+// at a time, ordered by the role's exchanges: pipeline.cpp), so the readings are a plain
+// fixed-size ring: no lock, no atomic, no allocation after construction.
 //
 // The match, for an orientation sample at time t whose previous sample was at t_prev: the mean
 // m and mean time c of the source's readings stamped in (t_prev, t]. The mean is the rate at c,

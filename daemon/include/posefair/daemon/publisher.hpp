@@ -4,8 +4,10 @@
 // sends each to every destination of every output that carries its stream. A pose is encoded
 // once per encoder (and angular-velocity choice), however many outputs share it. Owns the per-stream wire sequence numbers (0 at session start, +1 per pose; carried
 // over a SIGHUP reload) and the previous pose per stream for the optional angular velocity.
-// Runs on the publisher thread only; sockets are non-blocking, so a slow network never stalls
-// it (a full socket buffer is a counted send failure).
+// Runs on one thread at a time: the engine role's holder (a driver thread with fair_on =
+// "driver", or the engine thread), or the publisher thread with publish_on = "publisher"; sockets
+// are non-blocking, so a slow network never stalls it (a full socket buffer is a counted send
+// failure).
 #include <cstdint>
 #include <map>
 #include <memory>
