@@ -540,7 +540,7 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   auto quick = std::make_shared<bool>(false);
   quality->add_option("--data", *data, "folder with the recorded data sets (tum/, broad/, bvh/); default $POSEFAIR_DATA, else ../shared/data")->capture_default_str();
   quality->add_option("-o,--output", *out, "folder for the CSV files (quality-runs.csv, quality-summary.csv, quality-prediction-*.csv)")->capture_default_str();
-  quality->add_flag("--quick", *quick, "synthetic data only, shorter, fewer seeds (seconds, for tests)");
+  quality->add_flag("--quick", *quick, "synthetic data only, one noise level, shorter, fewer seeds (seconds, for tests)");
   quality->callback([=, &exit_code] { exit_code = bench_quality(*data, *out, *quick); });
   add_bench_latency_command(*bench, exit_code);
   add_bench_fusion_command(*bench, exit_code);

@@ -31,9 +31,6 @@ report_stages() {
 trap report_stages EXIT
 end_stage setup
 
-# Tests wait on sockets, child processes and timers as much as they compute: twice as many at once
-# as there are cores keeps both cores busy. (The soak runs alone: RUN_SERIAL.)
-test_jobs=$((2 * jobs))
 
 # Unity builds (CMakeLists.txt, POSEFAIR_UNITY_BUILD): a third less compile time for a build
 # from scratch, which is what this script does on a fresh clone.
@@ -46,7 +43,10 @@ test_jobs=$((2 * jobs))
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DPOSEFAIR_UNITY_BUILD=ON >/dev/null
 cmake --build build -j "$jobs" --target posefaird posefair benchmarks e2e_tests hw_tests
 end_stage "release build"
-ctest --test-dir build --output-on-failure -j "$test_jobs" -L 'e2e|soak'
+# The end-to-end tests wait on child processes, sockets and timers more than they compute: twice
+# as many at once as there are cores. (The soak runs alone: RUN_SERIAL.) The sanitizer runs below
+# are bound by computation, and their timed tests by how fast it goes: one per core there.
+ctest --test-dir build --output-on-failure -j "$((2 * jobs))" -L 'e2e|soak'
 end_stage "release tests (e2e, soak)"
 # The CAN, HID and GPIO tests (label hw) against Debian's real kernel, in one qemu boot.
 tests/hw/vm/run_hw_tests.sh build
@@ -64,7 +64,7 @@ cmake -S . -B build-asan -G Ninja "${sanitizer_flags[@]}" -DPOSEFAIR_SANITIZE_AD
 cmake --build build-asan -j "$jobs"
 end_stage "asan+ubsan build"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build-asan --output-on-failure -j "$test_jobs"
+  ctest --test-dir build-asan --output-on-failure -j "$jobs"
 end_stage "asan+ubsan tests"
 
 # ThreadSanitizer: the test programs labelled `threads` (target threads_tests, which also builds
@@ -73,5 +73,5 @@ cmake -S . -B build-tsan -G Ninja "${sanitizer_flags[@]}" -DPOSEFAIR_SANITIZE_TH
 cmake --build build-tsan -j "$jobs" --target threads_tests
 end_stage "tsan build"
 TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 \
-  ctest --test-dir build-tsan --output-on-failure -j "$test_jobs" -L threads
+  ctest --test-dir build-tsan --output-on-failure -j "$jobs" -L threads
 end_stage "tsan tests"

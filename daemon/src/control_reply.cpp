@@ -106,6 +106,7 @@ std::string streams_member(const std::vector<StreamStats>& now, const std::vecto
                                                     .number("time_offset_s", s.engine.gyro.time_offset_s)
                                                     .add("time_offset_estimated", s.engine.gyro.offset_estimated)
                                                     .add("intervals", s.engine.gyro.intervals)
+                                                    .add("bridged", s.gyro_bridged)
                                                     .add("source", s.gyro_pairing ? json_string(s.gyro_pairing->source) : "null")
                                                     .add("matched", s.gyro_pairing ? s.gyro_pairing->matched : 0)
                                                     .add("unmatched", s.gyro_pairing ? s.gyro_pairing->unmatched : 0)

@@ -506,6 +506,7 @@ bool Pipeline::engine_pass() {
     s.counters.emitted.store(w.emitted, std::memory_order_relaxed);
     s.counters.clamped.store(w.clamped, std::memory_order_relaxed);
     s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
+    s.counters.gyro.bridged.store(w.gyro_bridged, std::memory_order_relaxed);
     store_engine_state(s.counters, s.window.state());
     if (s.gyro_pairing) {
       s.counters.gyro.matched.store(s.gyro_pairing->matched(), std::memory_order_relaxed);
@@ -677,6 +678,7 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.emitted = get(s.counters.emitted);
     st.clamped = get(s.counters.clamped);
     st.restarts = get(s.counters.restarts);
+    st.gyro_bridged = get(s.counters.gyro.bridged);
     st.engine = load_engine_state(s.counters);
     st.publish_dropped = s.pose_ring.dropped();
     st.published = get(s.counters.published);

