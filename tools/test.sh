@@ -24,13 +24,40 @@ end_stage() {
 report_stages() {
   echo "test.sh: wall time per stage"
   for i in "${!stage_names[@]}"; do
-    printf '  %-28s %4d:%02d\n' "${stage_names[$i]}" $((stage_seconds[i] / 60)) $((stage_seconds[i] % 60))
+    printf '  %-44s %4d:%02d\n' "${stage_names[$i]}" $((stage_seconds[i] / 60)) $((stage_seconds[i] % 60))
   done
-  printf '  %-28s %4d:%02d\n' total $((SECONDS / 60)) $((SECONDS % 60))
+  printf '  %-44s %4d:%02d\n' total $((SECONDS / 60)) $((SECONDS % 60))
 }
-trap report_stages EXIT
-end_stage setup
 
+# A sanitizer build runs in the background while the stage before it runs its tests: the tests
+# wait on child processes, sockets, timers and the emulated kernel much of the time, and the
+# build, at the idle scheduling class (chrt --idle), takes only the CPU they leave. Its output
+# goes to a log that is printed when it is waited for.
+background_pid=""
+background_log=""
+start_background_build() {  # LOG CMAKE-BUILD-ARGS...
+  background_log=$1
+  shift
+  chrt --idle 0 cmake --build "$@" >"$background_log" 2>&1 &
+  background_pid=$!
+}
+wait_background_build() {
+  local status=0
+  wait "$background_pid" || status=$?
+  background_pid=""
+  if ((status != 0)); then
+    cat "$background_log"
+    echo "test.sh: the build in the background failed (log: $background_log)" >&2
+    exit "$status"
+  fi
+  tail -n 1 "$background_log"
+}
+on_exit() {
+  [[ -n $background_pid ]] && kill -- "$background_pid" 2>/dev/null
+  report_stages
+}
+trap on_exit EXIT
+end_stage setup
 
 # Unity builds (CMakeLists.txt, POSEFAIR_UNITY_BUILD): a third less compile time for a build
 # from scratch, which is what this script does on a fresh clone.
@@ -43,35 +70,40 @@ end_stage setup
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DPOSEFAIR_UNITY_BUILD=ON >/dev/null
 cmake --build build -j "$jobs" --target posefaird posefair benchmarks e2e_tests hw_tests
 end_stage "release build"
-# The end-to-end tests wait on child processes, sockets and timers more than they compute: twice
-# as many at once as there are cores. (The soak runs alone: RUN_SERIAL.) The sanitizer runs below
-# are bound by computation, and their timed tests by how fast it goes: one per core there.
-ctest --test-dir build --output-on-failure -j "$((2 * jobs))" -L 'e2e|soak'
-end_stage "release tests (e2e, soak)"
-# The CAN, HID and GPIO tests (label hw) against Debian's real kernel, in one qemu boot.
-tests/hw/vm/run_hw_tests.sh build
-end_stage "kernel VM tests (hw)"
 
 # The sanitizer builds compile at -O1 with line tables only (-g1): what ASan's own documentation
 # recommends, and about half the compile time of -O2 -g; reports still name file and line. They
-# build no benchmarks and no hw tests (those run only in the VM, above). The test programs' own
+# build no benchmarks and no hw tests (those run only in the VM, below). The test programs' own
 # code (not the libraries under test) compiles at -O0 there: their checks run in a few seconds
 # either way, and code generation is most of a sanitizer build's time.
 sanitizer_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
                  -DPOSEFAIR_BUILD_BENCHMARKS=OFF -DPOSEFAIR_BUILD_HW_TESTS=OFF
                  -DPOSEFAIR_UNITY_BUILD=ON -DPOSEFAIR_TEST_OPTIMIZATION=-O0)
 cmake -S . -B build-asan -G Ninja "${sanitizer_flags[@]}" -DPOSEFAIR_SANITIZE_ADDRESS=ON >/dev/null
-cmake --build build-asan -j "$jobs"
-end_stage "asan+ubsan build"
-ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build-asan --output-on-failure -j "$jobs"
-end_stage "asan+ubsan tests"
+start_background_build build-asan/background-build.log build-asan -j "$jobs"
+
+# The end-to-end tests wait on child processes, sockets and timers more than they compute: twice
+# as many at once as there are cores. (The soak runs alone: RUN_SERIAL.) The sanitizer runs below
+# are bound by computation, and their timed tests by how fast it goes: one per core there.
+ctest --test-dir build --output-on-failure -j "$((2 * jobs))" -L 'e2e|soak'
+end_stage "release tests (e2e, soak), asan build beside"
+# The CAN, HID and GPIO tests (label hw) against Debian's real kernel, in one qemu boot.
+tests/hw/vm/run_hw_tests.sh build
+end_stage "kernel VM tests (hw), asan build beside"
+wait_background_build
+end_stage "asan+ubsan build (the rest)"
 
 # ThreadSanitizer: the test programs labelled `threads` (target threads_tests, which also builds
-# the binaries they start), and only those.
-cmake -S . -B build-tsan -G Ninja "${sanitizer_flags[@]}" -DPOSEFAIR_SANITIZE_THREAD=ON >/dev/null
-cmake --build build-tsan -j "$jobs" --target threads_tests
-end_stage "tsan build"
+# posefaird, which they start), and only those; core and the `posefair` client come from the
+# Release build (POSEFAIR_PLAIN_BUILD, CMakeLists.txt says why). Built beside the ASan tests.
+cmake -S . -B build-tsan -G Ninja "${sanitizer_flags[@]}" -DPOSEFAIR_SANITIZE_THREAD=ON \
+  -DPOSEFAIR_PLAIN_BUILD="$PWD/build" >/dev/null
+start_background_build build-tsan/background-build.log build-tsan -j "$jobs" --target threads_tests
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  ctest --test-dir build-asan --output-on-failure -j "$jobs"
+end_stage "asan+ubsan tests, tsan build beside"
+wait_background_build
+end_stage "tsan build (the rest)"
 TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 \
   ctest --test-dir build-tsan --output-on-failure -j "$jobs" -L threads
 end_stage "tsan tests"

@@ -19,7 +19,8 @@ posefair_add_test(daemon_e2e_tests
   SOURCES daemon_e2e_tests.cpp
   LIBS posefair::protocol posefair::drivers posefair_replay_log
   LABELS "daemon;network;e2e;threads")
-add_dependencies(daemon_e2e_tests posefaird posefair)
+add_dependencies(daemon_e2e_tests posefaird)
+posefair_cli_dependency(daemon_e2e_tests)
 
 # status_report_tests.cpp: the counter lines and STATUS= text, with and without a device link;
 # in config_tests (CMakeLists.txt here), which has the same label.

@@ -71,7 +71,7 @@ TEST(PythonClient, TextOutputMatchesPosefairSub) {
   ASSERT_EQ(py.exit_code, 0) << py.err;
   TempDir dir2;
   const SubRun cpp = run_subscriber(
-      {POSEFAIR_BINARY_DIR "/tools/posefair", "sub", "--listen", "127.0.0.1:0", "--duration", "20", "--count", "6"}, sc,
+      {POSEFAIR_CLI_PROGRAM, "sub", "--listen", "127.0.0.1:0", "--duration", "20", "--count", "6"}, sc,
       dir2);
   ASSERT_EQ(cpp.exit_code, 0) << cpp.err;
   EXPECT_EQ(split_lines(py.out).size(), 6u);

@@ -19,7 +19,7 @@ namespace {
 
 using namespace std::chrono_literals;
 
-const std::string kPosefair = POSEFAIR_BINARY_DIR "/tools/posefair";
+const std::string kPosefair = POSEFAIR_CLI_PROGRAM;
 constexpr const char* kCsvHeader = "session,stream,seq,t,sent,qw,qx,qy,qz,px,py,pz,wx,wy,wz,flags,latency_us";
 
 std::vector<std::string> sub_args(std::vector<std::string> extra) {

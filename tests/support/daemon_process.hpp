@@ -30,7 +30,7 @@
 namespace posefair::testing {
 
 inline const std::string kPosefaird = POSEFAIR_BINARY_DIR "/daemon/posefaird";
-inline const std::string kPosefair = POSEFAIR_BINARY_DIR "/tools/posefair";
+inline const std::string kPosefair = POSEFAIR_CLI_PROGRAM;
 
 namespace daemon_process_detail {
 namespace fs = std::filesystem;

@@ -25,7 +25,7 @@ inline std::string q(const std::filesystem::path& p) {
 }
 
 inline CliResult run_posefair(const std::string& args, const ScratchDir& dir) {
-  const std::string bin = POSEFAIR_BINARY_DIR "/tools/posefair";
+  const std::string bin = POSEFAIR_CLI_PROGRAM;
   const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
   const std::string cmd = "'" + bin + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
   const int status = std::system(cmd.c_str());
