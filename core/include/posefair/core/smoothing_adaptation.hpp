@@ -26,6 +26,11 @@
 
 namespace posefair {
 
+// Valid ranges (validate(WindowConfig), the daemon's keys): time constants in (0, 600] s,
+// the margin in (0, 100].
+inline constexpr double kMaxAdaptationTime = 600.0;
+inline constexpr double kMaxMotionMargin = 100.0;
+
 struct AdaptationSettings {
   double noise_time_s = 2.0;   // how fast the noise estimate follows a change of noise
   double motion_time_s = 0.1;  // how fast the motion estimate follows the motion
