@@ -50,8 +50,8 @@ class MotionNoiseEstimator {
  public:
   MotionNoiseEstimator(int capacity, int order);
 
-  // Sets the fit's span for this rate (at least order + 3 samples, at most capacity) and
-  // forgets nothing else.
+  // Sets the fit's span for this rate (motion_span_s, at least order + 1 samples, at most
+  // capacity) and forgets nothing else.
   void configure(double rate_hz, const AdaptationSettings& settings);
 
   // After a new sample: zeta holds the window's n−1 differences, newest last; dt is the
