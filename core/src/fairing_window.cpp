@@ -112,7 +112,9 @@ void validate(const WindowConfig& c) {
   }
   const AdaptationSettings& a = c.adaptation;
   for (double t : {a.noise_time_s, a.motion_time_s, a.motion_span_s})
-    if (!(t > 0.0 && t <= 600.0)) bad(S::Adaptation, "the adaptation's time constants must be in (0, 600] seconds");
+    if (!(t > 0.0 && t <= kMaxAdaptationTime)) bad(S::Adaptation, "the adaptation's time constants must be in (0, 600] seconds");
+  if (!(a.motion_margin > 0.0 && a.motion_margin <= kMaxMotionMargin))
+    bad(S::Adaptation, "the adaptation's motion margin must be in (0, 100]");
   if (!(c.continuity >= 0.0) || !std::isfinite(c.continuity)) bad(S::Continuity, "continuity must be finite and >= 0");
   if (c.continuity > 0.0) {
     if (c.window == 0) bad(S::Continuity, "continuity needs a window in samples (its stability is checked for that window)");

@@ -22,7 +22,12 @@ MotionNoiseEstimator::MotionNoiseEstimator(int capacity, int order)
 void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& settings) {
   settings_ = settings;
   const int m = order_;
-  span_ = std::clamp(static_cast<int>(std::lround(settings.motion_span_s * rate_hz)), m + 3, std::max(m + 3, capacity_));
+  // The span is motion_span_s at the stream's rate, but never fewer than the m + 1 samples that
+  // determine a degree-m polynomial (then the fit is the plain m-th difference). At a low rate
+  // a longer minimum would stretch the span in time (m + 3 = 5 samples is 0.5 s at 10 Hz):
+  // its centre falls further behind and it averages away motion faster than the span, which
+  // the noise estimate then reads as noise (docs/engine.md, "Where it cannot help").
+  span_ = std::clamp(static_cast<int>(std::lround(settings.motion_span_s * rate_hz)), m + 1, std::max(m + 1, capacity_));
   span_ = std::min(span_, capacity_);
   // Least-squares polynomial of degree m through the span, its m-th derivative at the centre:
   // w_i = m!·[(XᵀX)⁻¹Xᵀ]_{m,i}, X_{iq} = (i − c)^q. At most 4×4 (m ≤ 3): fixed size, no heap.

@@ -89,6 +89,9 @@ epsilon_t = 0.5
 gap = 0.5
 unit_tolerance = 0.05
 rate_hz = 200
+noise_time = 4              # the adaptation's time constants (s) and margin
+motion_span = 0.5
+motion_margin = 3
 
 [[stream]]
 id = 7
@@ -114,6 +117,8 @@ solver = "gauss-newton"
 iterations = 3
 continuity = 0.5
 bound = "window"
+motion_time = 0.2           # noise_time and motion_span stay [engine]'s
+motion_margin = 1.5
 
 [[stream]]
 id = 8
@@ -213,6 +218,10 @@ TEST(Config, AFullConfigFillsEveryField) {
     EXPECT_EQ(e.bound, BoundPolicy::Window);
     EXPECT_EQ(e.gate.gap_threshold, 0.5);
     EXPECT_EQ(e.gate.unit_tolerance, 0.05);
+    EXPECT_EQ(e.adaptation.noise_time_s, 4.0);
+    EXPECT_EQ(e.adaptation.motion_time_s, 0.2);
+    EXPECT_EQ(e.adaptation.motion_span_s, 0.5);
+    EXPECT_EQ(e.adaptation.motion_margin, 1.5);
   }
   {
     const StreamConfig& s = c.streams[1];
@@ -265,6 +274,10 @@ TEST(Config, AFullConfigFillsEveryField) {
     EXPECT_EQ(e.epsilon_t, 0.5);
     EXPECT_EQ(e.gate.gap_threshold, 0.5);
     EXPECT_EQ(e.gate.unit_tolerance, 0.05);
+    EXPECT_EQ(e.adaptation.noise_time_s, 4.0);
+    EXPECT_EQ(e.adaptation.motion_time_s, AdaptationSettings{}.motion_time_s);
+    EXPECT_EQ(e.adaptation.motion_span_s, 0.5);
+    EXPECT_EQ(e.adaptation.motion_margin, 3.0);
   }
 
   ASSERT_EQ(c.outputs.size(), 2u);
@@ -395,6 +408,10 @@ driver = { type = "synthetic" }
   EXPECT_EQ(e.bound, d.bound);
   EXPECT_EQ(e.gate.gap_threshold, d.gate.gap_threshold);
   EXPECT_EQ(e.gate.unit_tolerance, d.gate.unit_tolerance);
+  EXPECT_EQ(e.adaptation.noise_time_s, d.adaptation.noise_time_s);
+  EXPECT_EQ(e.adaptation.motion_time_s, d.adaptation.motion_time_s);
+  EXPECT_EQ(e.adaptation.motion_span_s, d.adaptation.motion_span_s);
+  EXPECT_EQ(e.adaptation.motion_margin, d.adaptation.motion_margin);
 }
 
 TEST(Config, ASerialSourceFillsEveryField) {
@@ -1510,6 +1527,33 @@ id = 1
 name = "a"
 driver = { type = "synthetic", rate_hz = 100 }
 )", "engine.window_time: out of range: must be in (0, 60], got 0", 2},
+    {"noise_time zero", R"([engine]
+noise_time = 0
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+)", "engine.noise_time: out of range: must be in (0, 600], got 0", 2},
+    {"motion_span too long", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+[stream.engine]
+motion_span = 601
+)", "stream[1].engine.motion_span: out of range: must be in (0, 600], got 601", 6},
+    {"motion_time not a number", R"([engine]
+motion_time = "fast"
+[[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+)", "engine.motion_time: expected a number, got a string", 2},
+    {"negative motion_margin", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+engine = { motion_margin = -1 }
+)", "stream[1].engine.motion_margin: out of range: must be in (0, 100], got -1", 5},
     {"continuity with adapted smoothing", R"([engine]
 window = 32
 continuity = 1

@@ -26,6 +26,11 @@
 
 namespace posefair {
 
+// Valid ranges (validate(WindowConfig), the daemon's keys): time constants in (0, 600] s,
+// the margin in (0, 100].
+inline constexpr double kMaxAdaptationTime = 600.0;
+inline constexpr double kMaxMotionMargin = 100.0;
+
 struct AdaptationSettings {
   double noise_time_s = 2.0;   // how fast the noise estimate follows a change of noise
   double motion_time_s = 0.1;  // how fast the motion estimate follows the motion
@@ -45,8 +50,8 @@ class MotionNoiseEstimator {
  public:
   MotionNoiseEstimator(int capacity, int order);
 
-  // Sets the fit's span for this rate (at least order + 3 samples, at most capacity) and
-  // forgets nothing else.
+  // Sets the fit's span for this rate (motion_span_s, at least order + 1 samples, at most
+  // capacity) and forgets nothing else.
   void configure(double rate_hz, const AdaptationSettings& settings);
 
   // After a new sample: zeta holds the window's n−1 differences, newest last; dt is the
