@@ -35,10 +35,12 @@ report_stages() {
 # goes to a log that is printed when it is waited for.
 background_pid=""
 background_log=""
+low_priority=(chrt --idle 0)
+chrt --idle 0 true 2>/dev/null || low_priority=(nice -n 19)  # where SCHED_IDLE is not allowed
 start_background_build() {  # LOG CMAKE-BUILD-ARGS...
   background_log=$1
   shift
-  chrt --idle 0 cmake --build "$@" >"$background_log" 2>&1 &
+  "${low_priority[@]}" cmake --build "$@" >"$background_log" 2>&1 &
   background_pid=$!
 }
 wait_background_build() {
