@@ -10,7 +10,7 @@
 //     sensor-data profile), volatile.
 // Discovery is DDS's own (SPDP multicast on the default domain 0, or `domain_id`), so it works
 // with no Cyclone configuration file on one host and across a LAN. The participant is created at
-// the first pose, on the publisher thread, so `posefaird --check` and config parsing start no
+// the first pose, on the thread publishing it, so `posefaird --check` and config parsing start no
 // network traffic. Poses are in posefair's frame, which is ROS's (REP 103): no axes change.
 #include <dds/dds.h>
 
@@ -18,6 +18,7 @@
 #include <cctype>
 #include <cmath>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -45,7 +46,8 @@ class DdsPublisher final : public OutputEncoder {
   bool delivers() const override { return true; }
 
   bool deliver(const PoseMessage& m) const override {
-    if (participant_ == 0 && !open()) return false;
+    std::call_once(opened_, [this] { open(); });  // the streams' threads may get here at once
+    if (participant_ <= 0) return false;
     const auto t = std::find_if(topics_.begin(), topics_.end(), [&](const Topic& x) { return x.stream == m.stream; });
     if (t == topics_.end() || t->writer <= 0) return false;
     geometry_msgs_msg_dds__PoseStamped_ s{};
@@ -63,9 +65,9 @@ class DdsPublisher final : public OutputEncoder {
  private:
   // The participant, one topic and writer per stream. A failure (e.g. no usable network
   // interface) leaves participant_ negative: every pose then counts as a failed send.
-  bool open() const {
+  void open() const {
     participant_ = dds_create_participant(domain_, nullptr, nullptr);
-    if (participant_ < 0) return false;
+    if (participant_ < 0) return;
     dds_qos_t* qos = dds_create_qos();
     if (reliable_) {
       dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
@@ -81,13 +83,13 @@ class DdsPublisher final : public OutputEncoder {
       if (topic > 0) t.writer = dds_create_writer(participant_, topic, qos, nullptr);
     }
     dds_delete_qos(qos);
-    return true;
   }
 
   mutable std::vector<Topic> topics_;
   std::uint32_t domain_;
   bool reliable_;
   std::string frame_id_;
+  mutable std::once_flag opened_;
   mutable dds_entity_t participant_ = 0;
 };
 

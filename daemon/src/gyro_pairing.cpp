@@ -7,10 +7,15 @@ namespace posefair::daemon {
 
 static_assert((GyroPairing::kCapacity & (GyroPairing::kCapacity - 1)) == 0, "a power of two: indices wrap by mask");
 
-GyroPairing::GyroPairing() : ring_(kCapacity) {}
+GyroPairing::GyroPairing()
+    : inbox_(std::make_unique<SpscRing<InboxReading>>(kCapacity, OverflowPolicy::DropOldest)), ring_(kCapacity) {}
 
 void GyroPairing::add(double time, const Vec3& gyro) {
   if (!std::isfinite(time) || !gyro.allFinite()) return;
+  inbox_->push(InboxReading{time, {gyro.x(), gyro.y(), gyro.z()}});
+}
+
+void GyroPairing::keep(double time, const Vec3& gyro) {
   if (count_ > 0 && !(time > ring_[(next_ - 1) & (kCapacity - 1)].time)) return;
   ring_[next_ & (kCapacity - 1)] = Reading{time, gyro};
   ++next_;
@@ -18,6 +23,7 @@ void GyroPairing::add(double time, const Vec3& gyro) {
 }
 
 void GyroPairing::apply(Sample& s) {
+  for (InboxReading r; inbox_->pop(r);) keep(r.time, Vec3(r.gyro[0], r.gyro[1], r.gyro[2]));
   const double t = s.time;
   s.flags &= ~static_cast<std::uint32_t>(kHasGyro);
   // A repeated or older time (the engine's gate drops the sample) or a non-finite one (it

@@ -170,7 +170,7 @@ struct Pipeline::Stream final : drivers::SampleSink {
     counters.received.fetch_add(1, std::memory_order_relaxed);
     if (record_ring) record_ring->push(r);
     const bool stored = ring.push(r);
-    pipeline.handed_over();
+    pipeline.handed_over(*this);
     return stored;
   }
 
@@ -191,6 +191,11 @@ struct Pipeline::Stream final : drivers::SampleSink {
   std::optional<FusionStage> fusion;            // engine role only; [stream.fusion]
   std::optional<GyroPairing> gyro_pairing;      // engine role only; [stream.engine] gyro_stream
   std::vector<GyroPairing*> gyro_consumers;     // the pairings this stream's gyroscope readings go to
+  Stream* gyro_source = nullptr;                // [stream.engine] gyro_stream: the stream it reads
+  // The stream's engine role (see take_engine_role): held by the one thread fairing it.
+  std::atomic<bool> role{false};
+  std::uint64_t pop_ns = 0;                     // engine role: when the sample being faired was popped
+  bool stage_recorded = false;                  // engine role: that sample's engine stage is recorded
   StreamCounters counters;
   MadeGpioLines gpio;                           // [stream.gpio]: data-ready sink (driver thread), output line
   std::atomic<bool> driver_running{false};
@@ -266,6 +271,7 @@ void Pipeline::pair_gyro_streams() {
     if (Stream* source = sp->config.gyro_stream.empty() ? nullptr : find(sp->config.gyro_stream)) {
       sp->gyro_pairing.emplace();
       source->gyro_consumers.push_back(&*sp->gyro_pairing);
+      sp->gyro_source = source;
     }
   std::vector<bool> placed(streams_.size(), false);
   auto place = [&](auto&& self, Stream* s, std::size_t depth) -> void {
@@ -402,9 +408,9 @@ bool Pipeline::emit(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns
 // The first pose of a sample ends the sample's engine stage.
 void Pipeline::deliver(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns) {
   const std::uint64_t now = monotonic_ns();
-  if (!engine_stage_recorded_) {
-    stages_.engine.record(now - engine_pop_ns_);
-    engine_stage_recorded_ = true;
+  if (!s.stage_recorded) {
+    stages_.engine.record(now - s.pop_ns);
+    s.stage_recorded = true;
   }
   const RingPose p = pack(pose, s.index, enqueued_ns, now);
   if (engine_publishes())
@@ -451,8 +457,8 @@ bool Pipeline::fair(Stream& s, const Sample& raw, std::uint64_t enqueued_ns) {
 // holds, then the window's lagged tail.
 void Pipeline::flush_stream(Stream& s) {
   const std::uint64_t now = monotonic_ns();
-  engine_pop_ns_ = now;
-  engine_stage_recorded_ = false;
+  s.pop_ns = now;
+  s.stage_recorded = false;
   if (s.bridge) {
     const std::size_t n = s.bridge->flush(s.bridged);
     for (std::size_t i = 0; i < n; ++i) window_push(s, s.bridged[i], now);
@@ -461,116 +467,130 @@ void Pipeline::flush_stream(Stream& s) {
   for (int j = 0; j < k; ++j) emit(s, s.outputs[static_cast<std::size_t>(j)], now);
 }
 
-// The engine role's holder (the engine thread, or with [daemon] fair_on = "driver" a driver
-// thread): every stream's ring drained (a bounded batch each), ended streams flushed, the counters
+// The holder of s's engine role (the engine thread, or with [daemon] fair_on = "driver" a driver
+// thread): s's ring drained (a bounded batch), s flushed when its driver has ended, its counters
 // stored. True when anything was done.
-bool Pipeline::engine_pass() {
-  heartbeat_.fetch_add(1, std::memory_order_relaxed);
-  bool any = false;
-  for (Stream* sp : engine_order_) {
-    Stream& s = *sp;
-    RingSample r;
-    bool emitted = false;
-    for (int budget = kPopBudget; budget > 0 && s.ring.pop(r); --budget) {
-      any = true;
-      engine_pop_ns_ = monotonic_ns();
-      engine_stage_recorded_ = false;
-      stages_.ring_wait.record(engine_pop_ns_ - r.enqueued_ns);
-      if (hooks_.before_engine_sample) hooks_.before_engine_sample(s.config.id);
-      const Sample sample = unpack(r);
-      if (sample.has_gyro())
-        for (GyroPairing* p : s.gyro_consumers) p->add(sample.time, sample.gyro);
-      // A raw-only sample's quaternion is a placeholder, not a measurement: without a fusion
-      // stage ([stream.fusion]) to make an orientation from its readings it must not reach
-      // the window (the recorder has it already). Counted, and the stream goes on.
-      if (!sample.has_orientation() && !s.fusion) {
-        s.counters.raw_unfused.fetch_add(1, std::memory_order_relaxed);
-        continue;
-      }
-      emitted = fair(s, sample, r.enqueued_ns) || emitted;
-    }
-    // Wake the publisher after each stream's batch (not after the whole pass), so it works
-    // alongside the engine instead of after it.
-    if (emitted && !engine_publishes()) wake_publisher();
-    // The driver has ended and everything it delivered is in: hand over the lagged tail.
-    if (!s.flushed.load(std::memory_order_relaxed) && s.driver_done.load(std::memory_order_acquire) &&
-        s.ring.size_approx() == 0) {
-      flush_stream(s);
-      s.flushed.store(true, std::memory_order_relaxed);
-      any = true;
-    }
-    const GateCounters& g = s.window.gate_counters();
-    const WindowCounters& w = s.window.counters();
-    s.counters.rejected.store(g.rejected(), std::memory_order_relaxed);
-    s.counters.out_of_order.store(g.dropped(), std::memory_order_relaxed);
-    s.counters.emitted.store(w.emitted, std::memory_order_relaxed);
-    s.counters.clamped.store(w.clamped, std::memory_order_relaxed);
-    s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
-    s.counters.gyro.bridged.store(w.gyro_bridged, std::memory_order_relaxed);
-    store_engine_state(s.counters, s.window.state());
-    if (s.gyro_pairing) {
-      s.counters.gyro.matched.store(s.gyro_pairing->matched(), std::memory_order_relaxed);
-      s.counters.gyro.unmatched.store(s.gyro_pairing->unmatched(), std::memory_order_relaxed);
-    }
-    if (s.bridge) {
-      s.counters.bridged_gaps.store(s.bridge->counters().gaps, std::memory_order_relaxed);
-      s.counters.bridged_samples.store(s.bridge->counters().samples, std::memory_order_relaxed);
-    }
-    if (s.fusion) store_fusion_state(s.counters.fusion, s.fusion->state(), s.fusion->waiting());
-    if (s.bridge || s.resampler)
-      s.counters.lerp_fallbacks.store((s.bridge ? s.bridge->counters().lerp_fallbacks : 0) +
-                                          (s.resampler ? s.resampler->lerp_fallbacks() : 0),
-                                      std::memory_order_relaxed);
+bool Pipeline::stream_pass(Stream& s) {
+  // A gyro_stream source first, when its role is free, so this pass has the readings up to the
+  // samples it fairs (as the engine thread's order has them).
+  if (s.gyro_source && config_.daemon.fair_on == FairThread::Driver) {
+    bool source_any = false;
+    if (fair_stream(*s.gyro_source, 1, source_any)) wake_engine();  // what is left: the engine thread's
   }
-  if (any && !engine_publishes()) wake_publisher();
+  bool any = false;
+  bool emitted = false;
+  RingSample r;
+  for (int budget = kPopBudget; budget > 0 && s.ring.pop(r); --budget) {
+    any = true;
+    s.pop_ns = monotonic_ns();
+    s.stage_recorded = false;
+    stages_.ring_wait.record(s.pop_ns - r.enqueued_ns);
+    if (hooks_.before_engine_sample) hooks_.before_engine_sample(s.config.id);
+    const Sample sample = unpack(r);
+    if (sample.has_gyro())
+      for (GyroPairing* p : s.gyro_consumers) p->add(sample.time, sample.gyro);
+    // A raw-only sample's quaternion is a placeholder, not a measurement: without a fusion
+    // stage ([stream.fusion]) to make an orientation from its readings it must not reach
+    // the window (the recorder has it already). Counted, and the stream goes on.
+    if (!sample.has_orientation() && !s.fusion) {
+      s.counters.raw_unfused.fetch_add(1, std::memory_order_relaxed);
+      continue;
+    }
+    emitted = fair(s, sample, r.enqueued_ns) || emitted;
+  }
+  // The driver has ended and everything it delivered is in: hand over the lagged tail.
+  if (!s.flushed.load(std::memory_order_relaxed) && s.driver_done.load(std::memory_order_acquire) &&
+      s.ring.size_approx() == 0) {
+    flush_stream(s);
+    s.flushed.store(true, std::memory_order_relaxed);
+    any = emitted = true;
+  }
+  // Wake the publisher after each stream's batch (not after a pass over every stream), so it
+  // works alongside the engine instead of after it.
+  if (emitted && !engine_publishes()) wake_publisher();
+  const GateCounters& g = s.window.gate_counters();
+  const WindowCounters& w = s.window.counters();
+  s.counters.rejected.store(g.rejected(), std::memory_order_relaxed);
+  s.counters.out_of_order.store(g.dropped(), std::memory_order_relaxed);
+  s.counters.emitted.store(w.emitted, std::memory_order_relaxed);
+  s.counters.clamped.store(w.clamped, std::memory_order_relaxed);
+  s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
+  s.counters.gyro.bridged.store(w.gyro_bridged, std::memory_order_relaxed);
+  store_engine_state(s.counters, s.window.state());
+  if (s.gyro_pairing) {
+    s.counters.gyro.matched.store(s.gyro_pairing->matched(), std::memory_order_relaxed);
+    s.counters.gyro.unmatched.store(s.gyro_pairing->unmatched(), std::memory_order_relaxed);
+  }
+  if (s.bridge) {
+    s.counters.bridged_gaps.store(s.bridge->counters().gaps, std::memory_order_relaxed);
+    s.counters.bridged_samples.store(s.bridge->counters().samples, std::memory_order_relaxed);
+  }
+  if (s.fusion) store_fusion_state(s.counters.fusion, s.fusion->state(), s.fusion->waiting());
+  if (s.bridge || s.resampler)
+    s.counters.lerp_fallbacks.store((s.bridge ? s.bridge->counters().lerp_fallbacks : 0) +
+                                        (s.resampler ? s.resampler->lerp_fallbacks() : 0),
+                                    std::memory_order_relaxed);
   return any;
 }
 
-// fair_on = "driver": the engine role is a flag that one thread at a time holds. Taking and
-// releasing it orders everything the holders touch (windows, histograms, the publisher's
-// sockets) as the engine thread alone would be ordered. Both are exchanges (read-modify-write,
-// acquire and release): a hand-over that finds the role taken still writes the flag after its
-// push into the ring, so the holder's releasing exchange reads that write and sees the push, and
-// its look for work afterwards finds the sample. Either the hand-over takes the role, or the
-// holder sees its sample: none is left behind (and ThreadSanitizer can follow it, which it
-// cannot with fences).
-bool Pipeline::take_engine_role() { return !engine_role_.exchange(true, std::memory_order_acq_rel); }
-
-void Pipeline::release_engine_role() { engine_role_.exchange(false, std::memory_order_acq_rel); }
-
-// Work a holder must not leave behind when it lets go of the role: a sample in a ring, or a
-// stream whose driver ended and whose window is not flushed yet.
-bool Pipeline::engine_work_pending() const {
-  return std::any_of(streams_.begin(), streams_.end(), [](const auto& s) {
-    return s->ring.size_approx() > 0 ||
-           (s->driver_done.load(std::memory_order_acquire) && !s->flushed.load(std::memory_order_relaxed));
-  });
+// The engine thread's pass: every stream whose role is free (a gyro_stream source before the
+// streams it feeds). True when anything was done or is left to do.
+bool Pipeline::engine_pass() {
+  heartbeat_.fetch_add(1, std::memory_order_relaxed);
+  bool any = false;
+  for (Stream* sp : engine_order_)
+    if (fair_stream(*sp, 1, any)) any = true;
+  return any;
 }
 
-// fair_on = "driver", on the driver thread that has just handed a sample over: fair and publish
-// it here, with no wake and no second thread, unless another thread holds the engine role (which
-// then takes the sample: see take_engine_role).
-void Pipeline::fair_here() {
-  for (int round = 1; take_engine_role(); ++round) {
-    if (hooks_.on_engine_role) hooks_.on_engine_role(true);
-    engine_pass();
-    if (hooks_.on_engine_role) hooks_.on_engine_role(false);
-    release_engine_role();
-    if (!engine_work_pending()) return;
-    // A driver thread must get back to its device: after a few passes for the other streams'
-    // samples it leaves the rest to the engine thread.
-    if (round == kDriverPasses) {
-      wake_engine();
-      return;
-    }
+// Each stream has its own engine role: a flag that one thread at a time holds (its driver thread
+// that has just pushed a sample, the engine thread, or the driver thread of a stream it is the
+// gyro_stream source of). Taking and releasing it orders everything the holders touch (the window,
+// the stream's publisher state) as one thread alone would be ordered; what streams share (the
+// stage histograms, the sockets, a gyro pairing's inbox) is safe across threads on its own. So a
+// driver thread never waits for another stream's pass, and a stalled thread holds up only its
+// own stream. Both are exchanges (read-modify-write, acquire and release): a hand-over that finds
+// the role taken still writes the flag after its push into the ring, so the holder's releasing
+// exchange reads that write and sees the push, and its look for work afterwards finds the
+// sample. Either the hand-over takes the role, or the holder sees its sample: none is left
+// behind (and ThreadSanitizer can follow it, which it cannot with fences).
+bool Pipeline::take_engine_role(Stream& s) { return !s.role.exchange(true, std::memory_order_acq_rel); }
+
+void Pipeline::release_engine_role(Stream& s) { s.role.exchange(false, std::memory_order_acq_rel); }
+
+// Work a holder must not leave behind when it lets go of the role: a sample in the ring, or a
+// driver that ended and a window not flushed yet.
+bool Pipeline::engine_work_pending(const Stream& s) const {
+  return s.ring.size_approx() > 0 ||
+         (s.driver_done.load(std::memory_order_acquire) && !s.flushed.load(std::memory_order_relaxed));
+}
+
+// Passes s under its engine role until nothing is left for it, at most `rounds` times. Returns
+// false when done or when another thread holds the role (which then sees the work: see
+// take_engine_role); true when work is still left after the last round.
+bool Pipeline::fair_stream(Stream& s, int rounds, bool& any) {
+  for (int round = 1; round <= rounds; ++round) {
+    if (!take_engine_role(s)) return false;
+    any = stream_pass(s) || any;
+    release_engine_role(s);
+    if (!engine_work_pending(s)) return false;
   }
+  return true;
 }
 
-void Pipeline::handed_over() {
-  if (config_.daemon.fair_on == FairThread::Driver)
-    fair_here();
-  else
+// A driver thread has just pushed a sample into s's ring. With fair_on = "driver" it fairs and
+// publishes it here, with no wake and no second thread; a driver thread must get back to its
+// device, so after a few passes it leaves the rest to the engine thread.
+void Pipeline::handed_over(Stream& s) {
+  if (config_.daemon.fair_on != FairThread::Driver) {
     wake_engine();
+    return;
+  }
+  bool any = false;
+  if (hooks_.on_engine_role) hooks_.on_engine_role(true);
+  const bool left = fair_stream(s, kDriverPasses, any);
+  if (hooks_.on_engine_role) hooks_.on_engine_role(false);
+  if (left) wake_engine();
 }
 
 void Pipeline::engine_loop() {
@@ -579,17 +599,9 @@ void Pipeline::engine_loop() {
   const bool shared = config_.daemon.fair_on == FairThread::Driver;
   for (;;) {
     const std::uint32_t seen = engine_wake_.prepare();
-    bool any = false;
-    if (!shared) {
-      any = engine_pass();
-    } else if (take_engine_role()) {
-      // With fair_on = "driver" this thread fairs what no driver thread did: a stream's end,
-      // the drain at stop, a watchdog poke; the drivers do the rest.
-      any = engine_pass();
-      release_engine_role();
-      if (!any && engine_work_pending()) continue;
-    }
-    if (any) continue;
+    // With fair_on = "driver" this fairs what no driver thread did: a stream's end, the drain at
+    // stop, the samples a driver left after its passes; the drivers do the rest.
+    if (engine_pass()) continue;
     if (engine_stop_.load(std::memory_order_acquire)) return;
     if (busy_polling()) {  // a busy_poll stream runs: look again at once, never park
       cpu_relax();

@@ -26,13 +26,12 @@ Publisher::Publisher(std::uint32_t session, std::vector<std::uint32_t> stream_id
     for (std::uint32_t id : oc.streams)
       for (std::size_t i = 0; i < stream_ids.size(); ++i)
         if (stream_ids[i] == id) carries[i] = 1;
-    outputs_.push_back(Output{encoded_index(oc.encoder), oc.angular_velocity, std::move(carries), UdpSender(oc.destinations, oc.send),
+    outputs_.push_back(Output{encoder_index(oc.encoder), oc.angular_velocity, std::move(carries), UdpSender(oc.destinations, oc.send),
                               OutputRateLimit(oc.max_rate_hz, stream_ids.size())});
   }
   if (subscribers_) {
     for (const auto& encoder : subscribers_->encoders())  // an encoding not offered is never asked for
-      subscriber_encoded_.push_back(encoder ? encoded_index(encoder) : 0);
-    subscriber_view_ = subscribers_->make_view();
+      subscriber_encoded_.push_back(encoder ? encoder_index(encoder) : 0);
     subscriber_v4_ = UdpSocket::open(AF_INET);
     try {
       subscriber_v6_ = UdpSocket::open(AF_INET6);
@@ -40,16 +39,22 @@ Publisher::Publisher(std::uint32_t session, std::vector<std::uint32_t> stream_id
       // a host without IPv6: IPv6 subscribers are counted as failed sends
     }
   }
+  for (StreamState& st : streams_) {  // each stream's lane, allocated now
+    for (const auto& encoder : encoders_) {
+      Encoded e;
+      e.encoder = encoder;
+      e.buffer.resize(kMaxDatagramSize);
+      st.encoded.push_back(std::move(e));
+    }
+    if (subscribers_) st.subscriber_view = subscribers_->make_view();
+  }
 }
 
-std::size_t Publisher::encoded_index(const std::shared_ptr<const OutputEncoder>& encoder) {
-  const auto shared = std::find_if(encoded_.begin(), encoded_.end(), [&](const Encoded& e) { return e.encoder == encoder; });
-  if (shared != encoded_.end()) return static_cast<std::size_t>(shared - encoded_.begin());
-  Encoded e;
-  e.encoder = encoder;
-  e.buffer.resize(kMaxDatagramSize);
-  encoded_.push_back(std::move(e));
-  return encoded_.size() - 1;
+std::size_t Publisher::encoder_index(const std::shared_ptr<const OutputEncoder>& encoder) {
+  const auto shared = std::find(encoders_.begin(), encoders_.end(), encoder);
+  if (shared != encoders_.end()) return static_cast<std::size_t>(shared - encoders_.begin());
+  encoders_.push_back(encoder);
+  return encoders_.size() - 1;
 }
 
 Publisher::Result Publisher::publish(const RingPose& pose) {
@@ -74,12 +79,12 @@ Publisher::Result Publisher::publish(const RingPose& pose) {
   st.previous = m.orientation;
 
   m.send_time = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-  for (Encoded& e : encoded_) e.size = 0;
+  for (Encoded& e : st.encoded) e.size = 0;
   for (Output& out : outputs_) {
     if (!out.carries[pose.stream_index]) continue;
     result.carried = true;
     if (!out.rate_limit.admit(pose.stream_index, pose.time)) continue;
-    const OutputEncoder& encoder = *encoded_[out.encoded].encoder;
+    const OutputEncoder& encoder = *encoders_[out.encoded];
     const std::uint64_t t0 = monotonic_ns();
     if (encoder.delivers()) {  // its own transport (DDS): no datagram, no destinations; counted as sending
       m.angular_velocity = out.angular_velocity ? rate : std::nullopt;
@@ -87,22 +92,22 @@ Publisher::Result Publisher::publish(const RingPose& pose) {
       result.send_ns += monotonic_ns() - t0;
       continue;
     }
-    const std::span<const std::uint8_t> bytes = datagram(out.encoded, m, rate, out.angular_velocity);
+    const std::span<const std::uint8_t> bytes = datagram(st, out.encoded, m, rate, out.angular_velocity);
     const std::uint64_t t1 = monotonic_ns();
     const std::size_t sent = out.sender.send(bytes);
     result.encode_ns += t1 - t0;
     result.send_ns += monotonic_ns() - t1;
     result.failures += out.sender.destinations().size() - sent;
   }
-  if (subscribers_) result.failures += publish_to_subscribers(m, rate, result);
+  if (subscribers_) result.failures += publish_to_subscribers(st, m, rate, result);
   return result;
 }
 
-std::span<const std::uint8_t> Publisher::datagram(std::size_t index, PoseMessage& m, const std::optional<Vec3>& rate,
-                                                  bool with_rate) {
+std::span<const std::uint8_t> Publisher::datagram(StreamState& st, std::size_t index, PoseMessage& m,
+                                                  const std::optional<Vec3>& rate, bool with_rate) {
   m.angular_velocity = with_rate ? rate : std::nullopt;
   with_rate = m.angular_velocity.has_value();
-  Encoded& e = encoded_[index];
+  Encoded& e = st.encoded[index];
   if (e.size == 0 || e.with_rate != with_rate) {
     e.size = e.encoder->encode(m, e.buffer);
     e.with_rate = with_rate;
@@ -110,22 +115,24 @@ std::span<const std::uint8_t> Publisher::datagram(std::size_t index, PoseMessage
   return {e.buffer.data(), e.size};
 }
 
-std::size_t Publisher::publish_to_subscribers(PoseMessage& m, const std::optional<Vec3>& rate, Result& timing) {
-  subscribers_->refresh(subscriber_view_);
+std::size_t Publisher::publish_to_subscribers(StreamState& st, PoseMessage& m, const std::optional<Vec3>& rate,
+                                              Result& timing) {
+  SubscriberTable::View& view = st.subscriber_view;
+  subscribers_->refresh(view);
   const auto now = static_cast<std::int64_t>(monotonic_ns());
   std::size_t failures = 0;
-  for (std::size_t i = 0; i < subscriber_view_.count; ++i) {
-    const Subscriber& s = subscriber_view_.entries[i];
+  for (std::size_t i = 0; i < view.count; ++i) {
+    const Subscriber& s = view.entries[i];
     if (s.expires_ns <= now || !s.carries(m.stream)) continue;
     UdpSocket& socket = s.address.family() == AF_INET6 ? subscriber_v6_ : subscriber_v4_;
     const std::uint64_t t0 = monotonic_ns();
-    const std::span<const std::uint8_t> bytes = datagram(subscriber_encoded_[s.encoding], m, rate, s.angular_velocity);
+    const std::span<const std::uint8_t> bytes = datagram(st, subscriber_encoded_[s.encoding], m, rate, s.angular_velocity);
     const std::uint64_t t1 = monotonic_ns();
     const bool sent = socket.is_open() && socket.send_to(bytes, s.address);
     timing.encode_ns += t1 - t0;
     timing.send_ns += monotonic_ns() - t1;
     if (sent)
-      subscribers_->count_sent(subscriber_view_.slot[i], 1);
+      subscribers_->count_sent(view.slot[i], 1);
     else
       ++failures;
   }

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <charconv>
 #include <cstring>
@@ -251,14 +252,14 @@ bool operator==(const Endpoint& a, const Endpoint& b) {
 UdpSocket::~UdpSocket() { close(); }
 
 UdpSocket::UdpSocket(UdpSocket&& other) noexcept
-    : fd_(std::exchange(other.fd_, -1)), family_(other.family_), last_error_(other.last_error_) {}
+    : fd_(std::exchange(other.fd_, -1)), family_(other.family_), last_error_(other.last_error_.load(std::memory_order_relaxed)) {}
 
 UdpSocket& UdpSocket::operator=(UdpSocket&& other) noexcept {
   if (this != &other) {
     close();
     fd_ = std::exchange(other.fd_, -1);
     family_ = other.family_;
-    last_error_ = other.last_error_;
+    last_error_.store(other.last_error_.load(std::memory_order_relaxed), std::memory_order_relaxed);
   }
   return *this;
 }
@@ -374,7 +375,7 @@ std::optional<ReceivedDatagram> UdpSocket::receive(std::span<std::uint8_t> buffe
   const auto ms = std::clamp<std::chrono::milliseconds::rep>(timeout.count(), 0, std::numeric_limits<int>::max());
   const int ready = ::poll(&p, 1, static_cast<int>(ms));
   if (ready <= 0) {
-    if (ready < 0) last_error_ = errno;
+    if (ready < 0) last_error_.store(errno, std::memory_order_relaxed);
     return std::nullopt;
   }
   sockaddr_storage from{};
@@ -387,7 +388,7 @@ std::optional<ReceivedDatagram> UdpSocket::receive(std::span<std::uint8_t> buffe
   // MSG_TRUNC: Linux returns the datagram's real length even when it did not fit.
   const ssize_t n = ::recvmsg(fd_, &msg, MSG_TRUNC);
   if (n < 0) {
-    last_error_ = errno;
+    last_error_.store(errno, std::memory_order_relaxed);
     return std::nullopt;
   }
   ReceivedDatagram d;
@@ -403,7 +404,7 @@ bool UdpSocket::send_to(std::span<const std::uint8_t> datagram, const Endpoint& 
     const ssize_t n = ::sendto(fd_, datagram.data(), datagram.size(), MSG_NOSIGNAL, to.sockaddr_ptr(), to.sockaddr_len());
     if (n >= 0) return static_cast<std::size_t>(n) == datagram.size();
     if (errno == EINTR) continue;
-    last_error_ = errno;
+    last_error_.store(errno, std::memory_order_relaxed);
     return false;
   }
 }
@@ -417,56 +418,60 @@ UdpSender::UdpSender(std::vector<Endpoint> destinations, SendOptions options) : 
   if (need4) v4_ = UdpSocket::open(AF_INET, options);
   if (need6) v6_ = UdpSocket::open(AF_INET6, options);
   batched_ = options.sendmmsg && destinations_.size() > 1;
-  if (!batched_) return;
-  for (const Endpoint& to : destinations_) {
-    Batch& b = to.family() == AF_INET ? batch4_ : batch6_;
-    ::mmsghdr h{};
-    h.msg_hdr.msg_name = const_cast<sockaddr*>(to.sockaddr_ptr());  // sendmmsg does not write it
-    h.msg_hdr.msg_namelen = to.sockaddr_len();
-    h.msg_hdr.msg_iovlen = 1;
-    b.headers.push_back(h);
-  }
-  for (Batch* b : {&batch4_, &batch6_}) {
-    b->iov.resize(b->headers.size());
-    for (std::size_t i = 0; i < b->headers.size(); ++i) b->headers[i].msg_hdr.msg_iov = &b->iov[i];
-  }
+  for (const Endpoint& to : destinations_) (to.family() == AF_INET ? destinations4_ : destinations6_).push_back(to);
 }
 
-// Every header of the batch in as few sendmmsg calls as the kernel allows; a header the kernel
-// refuses is a failed send, and the rest are still sent.
-std::size_t UdpSender::send_batch(UdpSocket& socket, Batch& batch, std::span<const std::uint8_t> datagram) {
-  const std::size_t n = batch.headers.size();
+// Every destination of one family in as few sendmmsg calls as the kernel allows (the headers in
+// chunks on the stack, all pointing at one iovec); a header the kernel refuses is a failed send,
+// and the rest are still sent.
+std::size_t UdpSender::send_batch(const UdpSocket& socket, std::span<const Endpoint> family_destinations,
+                                  std::span<const std::uint8_t> datagram) {
+  const std::size_t n = family_destinations.size();
   if (n == 0) return 0;
   if (!socket.is_open()) {
-    failures_ += n;
+    failures_.fetch_add(n, std::memory_order_relaxed);
     return 0;
   }
-  for (::iovec& v : batch.iov) v = ::iovec{const_cast<std::uint8_t*>(datagram.data()), datagram.size()};
-  std::size_t ok = 0;
-  for (std::size_t next = 0; next < n;) {
-    const int sent = ::sendmmsg(socket.fd(), batch.headers.data() + next, static_cast<unsigned>(n - next), MSG_NOSIGNAL);
-    if (sent < 0 && errno == EINTR) continue;
-    if (sent <= 0) {  // the header at `next` failed: count it, go on with the next one
-      ++failures_;
-      ++next;
-      continue;
+  constexpr std::size_t kChunk = 16;
+  ::iovec iov{const_cast<std::uint8_t*>(datagram.data()), datagram.size()};  // sendmmsg does not write it
+  std::array<::mmsghdr, kChunk> headers{};
+  std::size_t ok = 0, failed = 0;
+  for (std::size_t first = 0; first < n; first += kChunk) {
+    const std::size_t m = std::min(kChunk, n - first);
+    for (std::size_t i = 0; i < m; ++i) {
+      const Endpoint& to = family_destinations[first + i];
+      headers[i] = ::mmsghdr{};
+      headers[i].msg_hdr.msg_name = const_cast<sockaddr*>(to.sockaddr_ptr());  // sendmmsg does not write it
+      headers[i].msg_hdr.msg_namelen = to.sockaddr_len();
+      headers[i].msg_hdr.msg_iov = &iov;
+      headers[i].msg_hdr.msg_iovlen = 1;
     }
-    for (int i = 0; i < sent; ++i)
-      if (batch.headers[next + static_cast<std::size_t>(i)].msg_len == datagram.size()) ++ok; else ++failures_;
-    next += static_cast<std::size_t>(sent);
+    for (std::size_t next = 0; next < m;) {
+      const int sent = ::sendmmsg(socket.fd(), headers.data() + next, static_cast<unsigned>(m - next), MSG_NOSIGNAL);
+      if (sent < 0 && errno == EINTR) continue;
+      if (sent <= 0) {  // the header at `next` failed: count it, go on with the next one
+        ++failed;
+        ++next;
+        continue;
+      }
+      for (int i = 0; i < sent; ++i)
+        if (headers[next + static_cast<std::size_t>(i)].msg_len == datagram.size()) ++ok; else ++failed;
+      next += static_cast<std::size_t>(sent);
+    }
   }
+  if (failed) failures_.fetch_add(failed, std::memory_order_relaxed);
   return ok;
 }
 
 std::size_t UdpSender::send(std::span<const std::uint8_t> datagram) {
-  if (batched_) return send_batch(v4_, batch4_, datagram) + send_batch(v6_, batch6_, datagram);
+  if (batched_) return send_batch(v4_, destinations4_, datagram) + send_batch(v6_, destinations6_, datagram);
   std::size_t ok = 0;
   for (const Endpoint& to : destinations_) {
     UdpSocket& s = to.family() == AF_INET ? v4_ : v6_;
     if (s.is_open() && s.send_to(datagram, to))
       ++ok;
     else
-      ++failures_;
+      failures_.fetch_add(1, std::memory_order_relaxed);
   }
   return ok;
 }

@@ -1,12 +1,12 @@
 #pragma once
 // [stream.engine] gyro_stream (docs/fusion.md, "A gyroscope from another stream"): an
 // orientation stream gets its gyroscope readings from another stream on the same body, e.g. an
-// optical tracker at 120 Hz from an IMU at 1 kHz. Both streams' samples reach the engine thread
-// through their own SPSC rings; the engine role's holder adds each gyroscope reading of the
-// source here (add) and, before fairing each orientation sample of the paired stream, gives it
-// the source's angular velocity at its time (apply). Both run under the engine role (one thread
-// at a time, ordered by the role's exchanges: pipeline.cpp), so the readings are a plain
-// fixed-size ring: no lock, no atomic, no allocation after construction.
+// optical tracker at 120 Hz from an IMU at 1 kHz. Each stream has its own engine role
+// (pipeline.cpp): the source's holder adds each gyroscope reading here (add), and the paired
+// stream's holder, before fairing each orientation sample, gives it the source's angular velocity
+// at its time (apply). The two may run on two threads at once, so add() only puts the reading into
+// an inbox (an SPSC ring that keeps the newest kCapacity), and apply() moves the inbox into the
+// readings it matches against, which are its own: no lock, no allocation after construction.
 //
 // The match, for an orientation sample at time t whose previous sample was at t_prev: the mean
 // m and mean time c of the source's readings stamped in (t_prev, t]. The mean is the rate at c,
@@ -23,9 +23,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "posefair/core/sample.hpp"
+#include "posefair/daemon/spsc_ring.hpp"
 
 namespace posefair::daemon {
 
@@ -36,8 +38,8 @@ class GyroPairing {
 
   GyroPairing();
 
-  // A reading of the source stream (its Sample::time, rad/s in the source's frame). One that is
-  // not finite, or not later than the newest kept, is left out.
+  // A reading of the source stream (its Sample::time, rad/s in the source's frame), from the
+  // source's engine role. One that is not finite, or not later than the newest kept, is left out.
   void add(double time, const Vec3& gyro);
   // An orientation sample of the paired stream, in arrival order: on a match its gyro becomes
   // the source's rate at its time (kHasGyro); otherwise any gyro it had is taken away, so the
@@ -52,7 +54,13 @@ class GyroPairing {
     double time = 0.0;
     Vec3 gyro = Vec3::Zero();
   };
-  std::vector<Reading> ring_;  // kCapacity entries, the newest at next_ - 1
+  struct InboxReading {  // trivially copyable, for the SPSC ring
+    double time;
+    double gyro[3];
+  };
+  void keep(double time, const Vec3& gyro);  // a reading from the inbox into ring_
+  std::unique_ptr<SpscRing<InboxReading>> inbox_;  // add() → apply(), across threads
+  std::vector<Reading> ring_;  // kCapacity entries, the newest at next_ - 1 (apply()'s thread only)
   std::size_t next_ = 0, count_ = 0;
   double last_time_ = std::numeric_limits<double>::quiet_NaN();  // the previous orientation sample's time
   double last_interval_ = 0.0;  // t − t_prev of the previous sample; 0 before the second sample

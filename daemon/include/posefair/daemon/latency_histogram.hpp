@@ -1,6 +1,6 @@
 #pragma once
-// LatencyHistogram: durations in nanoseconds, recorded by one thread (wait-free, no
-// allocation, relaxed/release atomic stores) and read by any other thread as a
+// LatencyHistogram: durations in nanoseconds, recorded by any threads (lock-free, no
+// allocation, relaxed/release atomic read-modify-writes) and read by any other thread as a
 // HistogramSnapshot, a plain value that can be kept, compared and diffed.
 //
 // Buckets are log-linear (HdrHistogram style): 0..127 ns exact to the nanosecond, then every
@@ -118,14 +118,17 @@ class LatencyHistogram {
   LatencyHistogram(const LatencyHistogram&) = delete;
   LatencyHistogram& operator=(const LatencyHistogram&) = delete;
 
-  // One recording thread at a time (single writer: plain load + store, no read-modify-write).
+  // Any number of recording threads at once (each stream's engine role records the pipeline's
+  // stage histograms): read-modify-write atomics, relaxed; min and max by compare-exchange, which
+  // loops only while another thread moves them the same way.
   void record(std::uint64_t ns) noexcept {
-    if (ns < min_.load(std::memory_order_relaxed)) min_.store(ns, std::memory_order_relaxed);
-    if (ns > max_.load(std::memory_order_relaxed)) max_.store(ns, std::memory_order_relaxed);
-    sum_.store(sum_.load(std::memory_order_relaxed) + ns, std::memory_order_relaxed);
+    for (std::uint64_t m = min_.load(std::memory_order_relaxed); ns < m && !min_.compare_exchange_weak(m, ns, std::memory_order_relaxed);) {
+    }
+    for (std::uint64_t m = max_.load(std::memory_order_relaxed); ns > m && !max_.compare_exchange_weak(m, ns, std::memory_order_relaxed);) {
+    }
+    sum_.fetch_add(ns, std::memory_order_relaxed);
     // Release: a reader that sees this count also sees the min, max and sum above.
-    auto& b = buckets_[HistogramSnapshot::bucket_of(ns)];
-    b.store(b.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+    buckets_[HistogramSnapshot::bucket_of(ns)].fetch_add(1, std::memory_order_release);
   }
 
   // Any thread, any time.

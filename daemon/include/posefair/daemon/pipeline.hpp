@@ -10,10 +10,12 @@
 // it sends the poses itself, right after fairing (no second hop, no publisher thread); with
 // "publisher" a publisher thread is fed through rings, so a slow network cannot stall the
 // engine. Each ring's overflow is counted. Every stage's latency is kept (stage_latency.hpp).
-// With [daemon] fair_on = "driver" the driver thread that hands a sample over fairs it (and, with
-// publish_on = "engine", sends it) itself when no other thread is doing so: the engine role is a
-// flag one thread holds at a time, and the engine thread keeps only what no driver does (a
-// stream's end, the drain at stop, the watchdog's poke). No wake, no hop between threads.
+// With [daemon] fair_on = "driver" (the default) the driver thread that hands a sample over fairs
+// it (and, with publish_on = "engine", sends it) itself: each stream has an engine role, a flag
+// one thread holds at a time, which its driver takes unless the engine thread holds it. Drivers
+// of different streams fair at once and never wait for each other. The engine thread keeps only
+// what no driver does (a stream's end, the drain at stop, the watchdog's poke, what a driver
+// left after its passes). No wake, no hop between threads.
 // A SIGHUP reload builds a new Pipeline from the new config while the old one runs, then stops
 // the old one (drained) and starts the new one: the swap is whole.
 #include <atomic>
@@ -42,8 +44,8 @@ struct PipelineHooks {
   // Called first thing on the engine thread and on the publisher thread (tests: count what
   // those threads allocate).
   std::function<void()> on_realtime_thread_start;
-  // Called on a driver thread when it takes the engine role (true) and lets it go (false), with
-  // fair_on = "driver" (tests: count what a driver thread allocates while it fairs).
+  // Called on a driver thread before it tries its stream's engine role (true) and after it has let
+  // it go (false), with fair_on = "driver" (tests: count what a driver thread allocates while it fairs).
   std::function<void(bool held)> on_engine_role;
 };
 
@@ -107,11 +109,12 @@ class Pipeline {
   struct Stream;
   void engine_loop();
   bool engine_pass();
-  bool take_engine_role();
-  void release_engine_role();
-  bool engine_work_pending() const;
-  void fair_here();
-  void handed_over();  // a driver thread has pushed a sample into its stream's ring
+  bool stream_pass(Stream& s);
+  bool take_engine_role(Stream& s);
+  void release_engine_role(Stream& s);
+  bool engine_work_pending(const Stream& s) const;
+  bool fair_stream(Stream& s, int rounds, bool& any);
+  void handed_over(Stream& s);  // a driver thread has pushed a sample into its stream's ring
   static constexpr int kDriverPasses = 4;  // fair_on = "driver": passes a driver thread makes at most
   bool emit(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns);
   void deliver(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns);
@@ -141,10 +144,7 @@ class Pipeline {
   WakeSignal publisher_wake_;
   AdaptiveSpin engine_spin_, publisher_spin_;  // each used by its own thread only
   StageLatency stages_;
-  std::uint64_t engine_pop_ns_ = 0;    // engine thread: when the sample being faired was popped
-  bool engine_stage_recorded_ = false;  // engine thread: its engine stage is recorded
   std::atomic<std::uint64_t> heartbeat_{0};
-  std::atomic<bool> engine_role_{false};  // fair_on = "driver": held by the thread running engine_pass()
   std::atomic<bool> engine_stop_{false};
   std::atomic<bool> publisher_stop_{false};
   std::atomic<bool> recorder_stop_{false};

@@ -4,10 +4,13 @@
 // sends each to every destination of every output that carries its stream. A pose is encoded
 // once per encoder (and angular-velocity choice), however many outputs share it. Owns the per-stream wire sequence numbers (0 at session start, +1 per pose; carried
 // over a SIGHUP reload) and the previous pose per stream for the optional angular velocity.
-// Runs on one thread at a time: the engine role's holder (a driver thread with fair_on =
-// "driver", or the engine thread), or the publisher thread with publish_on = "publisher"; sockets
-// are non-blocking, so a slow network never stalls it (a full socket buffer is a counted send
-// failure).
+// publish() runs for one stream on one thread at a time, and for different streams on several
+// threads at once: each stream's engine role holder (its driver thread with fair_on = "driver",
+// or the engine thread) publishes that stream's poses, or the publisher thread all of them with
+// publish_on = "publisher". So everything publish() writes is the stream's own (its sequence,
+// its previous pose, its lane: the encoders' buffers and the subscriber view); the sockets are
+// shared (the kernel serialises sends) and non-blocking, so a slow network never stalls it (a
+// full socket buffer is a counted send failure).
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -54,13 +57,13 @@ class Publisher {
 
  private:
   struct Output {
-    std::size_t encoded;  // index into encoded_: the datagram of this output's encoder
+    std::size_t encoded;  // index into encoders_ (and each stream's encoded): this output's encoder
     bool angular_velocity;
     std::vector<char> carries;  // per stream index
     UdpSender sender;
     OutputRateLimit rate_limit;  // max_rate_hz
   };
-  // One per distinct encoder among the outputs: its datagram for the pose being published.
+  // One per distinct encoder among the outputs, per stream: its datagram for the pose being published.
   struct Encoded {
     std::shared_ptr<const OutputEncoder> encoder;
     std::vector<std::uint8_t> buffer;  // kMaxDatagramSize bytes, allocated once
@@ -74,22 +77,25 @@ class Publisher {
     bool have_previous = false;
     double previous_time = 0.0;
     Quat previous = Quat::Identity();
+    // The stream's lane: scratch that only the thread publishing this stream touches.
+    std::vector<Encoded> encoded;          // indexed like encoders_
+    SubscriberTable::View subscriber_view;  // its own copy of the subscriber table's entries
   };
-  // The encoded_ entry of this encoder, added on first use (outputs sharing an encoder share it).
-  std::size_t encoded_index(const std::shared_ptr<const OutputEncoder>& encoder);
-  // The datagram of encoded_[index] for m, encoded on first use for this pose.
-  std::span<const std::uint8_t> datagram(std::size_t index, PoseMessage& m, const std::optional<Vec3>& rate, bool with_rate);
+  // The encoders_ index of this encoder, added on first use (outputs sharing an encoder share it).
+  std::size_t encoder_index(const std::shared_ptr<const OutputEncoder>& encoder);
+  // The datagram of st.encoded[index] for m, encoded on first use for this pose.
+  static std::span<const std::uint8_t> datagram(StreamState& st, std::size_t index, PoseMessage& m, const std::optional<Vec3>& rate,
+                                                bool with_rate);
   // Sends m to the subscribers that carry its stream and whose lease runs; returns failed sends.
-  std::size_t publish_to_subscribers(PoseMessage& m, const std::optional<Vec3>& rate, Result& timing);
+  std::size_t publish_to_subscribers(StreamState& st, PoseMessage& m, const std::optional<Vec3>& rate, Result& timing);
 
   std::uint32_t session_;
   std::vector<Output> outputs_;
   std::vector<StreamState> streams_;
-  std::vector<Encoded> encoded_;
-  // Subscribers (subscriber_table.hpp): the table, the publisher's own copy of its entries, the
-  // encoded_ index of each registered encoding, and a socket per family to send from.
+  std::vector<std::shared_ptr<const OutputEncoder>> encoders_;  // the distinct encoders
+  // Subscribers (subscriber_table.hpp): the table, the encoders_ index of each registered
+  // encoding, and a socket per family to send from.
   std::shared_ptr<SubscriberTable> subscribers_;
-  SubscriberTable::View subscriber_view_;
   std::vector<std::size_t> subscriber_encoded_;
   UdpSocket subscriber_v4_, subscriber_v6_;
 };

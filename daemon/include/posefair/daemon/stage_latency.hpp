@@ -8,9 +8,10 @@
 //   encode      the pose's datagrams encoded (every output's encoder, summed)
 //   send        the datagrams sent (every sendto/sendmmsg of the pose, summed)
 //
-// Each histogram has a single writer (LatencyHistogram's rule): ring wait and engine are
-// written by the engine thread, the other three by whichever one thread publishes. Recording
-// is a few relaxed stores, no allocation: safe on the real-time threads.
+// Each stream's engine role (the engine thread, or its driver thread) records ring wait and engine,
+// the thread that publishes the three others; streams fair on several threads at once, so each
+// histogram has many writers (LatencyHistogram takes any number). Recording is a few relaxed
+// atomic read-modify-writes, no allocation: safe on the real-time threads.
 #include "posefair/daemon/latency_histogram.hpp"
 
 namespace posefair::daemon {

@@ -8,6 +8,7 @@
 #include <sys/socket.h>
 #include <sys/uio.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -15,6 +16,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace posefair::daemon {
@@ -109,9 +111,10 @@ class UdpSocket {
   // buffer is consumed whole and reported with truncated = true and its real size.
   std::optional<ReceivedDatagram> receive(std::span<std::uint8_t> buffer, std::chrono::milliseconds timeout);
 
-  // Sends one datagram; false (and errno kept in last_error()) on failure.
+  // Sends one datagram; false (and errno kept in last_error()) on failure. Several threads may
+  // send on one socket at once (each stream's engine role publishes its own poses).
   bool send_to(std::span<const std::uint8_t> datagram, const Endpoint& to);
-  int last_error() const { return last_error_; }
+  int last_error() const { return last_error_.load(std::memory_order_relaxed); }
 
  private:
   UdpSocket(int fd, int family) : fd_(fd), family_(family) {}
@@ -119,35 +122,38 @@ class UdpSocket {
 
   int fd_ = -1;
   int family_ = 0;
-  int last_error_ = 0;
+  std::atomic<int> last_error_{0};
 };
 
 // One datagram to a list of destinations, IPv4 and IPv6 mixed (one socket per family the list
 // needs, opened by the constructor, which throws std::system_error if it cannot). send() never
 // throws; failed sends are counted. With SendOptions::sendmmsg, the destinations of one family
 // are sent to in one sendmmsg(2) call (one system call instead of one per destination; the
-// message headers are built once, here).
+// message headers are built on the stack per call). send() may run on several threads at once.
 class UdpSender {
  public:
   explicit UdpSender(std::vector<Endpoint> destinations, SendOptions options = {});
+  UdpSender(UdpSender&& other) noexcept
+      : destinations_(std::move(other.destinations_)),
+        destinations4_(std::move(other.destinations4_)),
+        destinations6_(std::move(other.destinations6_)),
+        v4_(std::move(other.v4_)),
+        v6_(std::move(other.v6_)),
+        batched_(other.batched_),
+        failures_(other.failures_.load(std::memory_order_relaxed)) {}
   // Sends to every destination in order; returns how many sends succeeded.
   std::size_t send(std::span<const std::uint8_t> datagram);
   const std::vector<Endpoint>& destinations() const { return destinations_; }
-  std::uint64_t failures() const { return failures_; }
+  std::uint64_t failures() const { return failures_.load(std::memory_order_relaxed); }
 
  private:
-  // The destinations of one family, as sendmmsg's headers (their iovec filled per send).
-  struct Batch {
-    std::vector<::mmsghdr> headers;
-    std::vector<::iovec> iov;  // one per header, all pointing at the datagram being sent
-  };
-  std::size_t send_batch(UdpSocket& socket, Batch& batch, std::span<const std::uint8_t> datagram);
+  std::size_t send_batch(const UdpSocket& socket, std::span<const Endpoint> family_destinations, std::span<const std::uint8_t> datagram);
 
   std::vector<Endpoint> destinations_;
+  std::vector<Endpoint> destinations4_, destinations6_;  // by family, for sendmmsg
   UdpSocket v4_, v6_;
   bool batched_ = false;
-  Batch batch4_, batch6_;
-  std::uint64_t failures_ = 0;
+  std::atomic<std::uint64_t> failures_{0};
 };
 
 }  // namespace posefair::daemon
