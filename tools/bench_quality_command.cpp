@@ -475,7 +475,7 @@ void print_prediction(const std::vector<PredictionRuns>& all, std::ofstream& sum
 
 // ---------------------------------------------------------------------------------------------
 
-int bench_quality(const std::string& data_dir, const std::string& out_dir, bool quick) {
+int bench_quality(const std::string& data_dir, const std::string& out_dir, bool quick, const std::vector<std::string>& only) {
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<QualityDataset> sets;
   try {
@@ -484,6 +484,18 @@ int bench_quality(const std::string& data_dir, const std::string& out_dir, bool 
     std::cerr << "posefair bench quality: " << e.what() << "\n";
     return exit_code(ErrorKind::NoInput);
   }
+  // --set: the named data sets alone (a name, or a kind: "broad", "tum", "bvh", "synthetic").
+  for (const std::string& name : only)
+    if (std::none_of(sets.begin(), sets.end(), [&](const QualityDataset& d) { return d.name == name || d.kind == name; })) {
+      std::cerr << "posefair bench quality: no data set or kind '" << name << "'; there are:";
+      for (const QualityDataset& d : sets) std::cerr << " " << d.name;
+      std::cerr << "\n";
+      return exit_code(ErrorKind::Usage);
+    }
+  if (!only.empty())
+    std::erase_if(sets, [&](const QualityDataset& d) {
+      return std::none_of(only.begin(), only.end(), [&](const std::string& n) { return d.name == n || d.kind == n; });
+    });
   std::filesystem::create_directories(out_dir);
   std::ofstream runs(out_dir + "/quality-runs.csv"), summary(out_dir + "/quality-summary.csv");
   std::ofstream pruns(out_dir + "/quality-prediction-runs.csv"), psummary(out_dir + "/quality-prediction-summary.csv");
@@ -538,10 +550,12 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   auto data = std::make_shared<std::string>(benchmark_data_dir().string());  // $POSEFAIR_DATA or ../shared/data
   auto out = std::make_shared<std::string>("build/bench-quality");
   auto quick = std::make_shared<bool>(false);
+  auto only = std::make_shared<std::vector<std::string>>();
   quality->add_option("--data", *data, "folder with the recorded data sets (tum/, broad/, bvh/); default $POSEFAIR_DATA, else ../shared/data")->capture_default_str();
   quality->add_option("-o,--output", *out, "folder for the CSV files (quality-runs.csv, quality-summary.csv, quality-prediction-*.csv)")->capture_default_str();
   quality->add_flag("--quick", *quick, "synthetic data only, one noise level, shorter, fewer seeds (seconds, for tests)");
-  quality->callback([=, &exit_code] { exit_code = bench_quality(*data, *out, *quick); });
+  quality->add_option("--set", *only, "run only this data set or kind (broad, tum, bvh, synthetic); repeat it for several (default: all)");
+  quality->callback([=, &exit_code] { exit_code = bench_quality(*data, *out, *quick, *only); });
   add_bench_latency_command(*bench, exit_code);
   add_bench_fusion_command(*bench, exit_code);
   add_bench_gyro_fairing_command(*bench, exit_code);

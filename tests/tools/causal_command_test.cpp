@@ -1,5 +1,7 @@
 // `posefair fair --causal` runs the real-time engine over a file exactly as the daemon will:
 // its output must equal the engine called directly, sample for sample, bit for bit.
+#include <filesystem>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -133,6 +135,16 @@ TEST(BenchQuality, QuickRunTunesOnTrainingSeedsAndReportsEveryRow) {
   EXPECT_THAT(r.out, HasSubstr("| One Euro tuned | 10 ms |"));
   EXPECT_THAT(r.out, HasSubstr("Where posefair's defaults lose"));
   EXPECT_THAT(r.out, Not(HasSubstr("none fits")));  // every budget has a row of every tuned family
+}
+
+// --set runs one data set or kind alone; a name that is none of them is a usage error that
+// lists what there is (here --quick: the synthetic set alone).
+TEST(BenchQuality, SetNamesTheDataSetsToRun) {
+  ScratchDir dir;
+  const auto r = run_posefair("bench quality --quick --set broad -o '" + dir.path().string() + "'", dir);
+  EXPECT_EQ(r.exit_code, 64);
+  EXPECT_THAT(r.err, HasSubstr("no data set or kind 'broad'; there are: synthetic-100Hz-noise0.01"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "quality-runs.csv")) << "nothing runs after a usage error";
 }
 
 }  // namespace
