@@ -10,6 +10,7 @@
 
 #include "posefair/core/difference_operators.hpp"
 #include "posefair/core/engine_setting.hpp"
+#include "posefair/core/weighted_vector_sum.hpp"
 
 namespace posefair {
 namespace {
@@ -271,12 +272,13 @@ void FairingWindow::prepare(double rate_hz) {
 void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
   if (!ch.adaptive || !prepared_) return;
   MotionNoiseEstimator& estimator = &ch == &rot_ && aided_ ? aided_estimator_ : ch.estimator;
-  estimator.update(zeta, dt);
+  const bool refreshed = estimator.update(zeta, dt);
   if (!estimator.ready()) {
     ch.level = 0.0;
     ch.mu = 0.0;
     return;
   }
+  if (!refreshed) return;  // the level follows the motion estimate's refreshes
   ch.level = best_level(levels_, level_count_, estimator.noise_variance(), config_.adaptation.motion_margin * estimator.motion_variance());
   // The μ a window still filling uses, and the one reported: geometric between the levels
   // (linear from the pass-through level 0).
@@ -291,23 +293,18 @@ namespace {
 
 // u = Σ_j row.zeta_j ζ_j (+ Σ_i row.c_i c_i over emitted samples).
 Vec3 apply_row(const EmissionRow& row, int n, std::span<const Vec3> zeta, std::span<const Vec3> c, int emitted, bool continuity) {
-  Vec3 e = Vec3::Zero();
-  for (int j = row.first; j < n - 1; ++j) e += row.zeta[static_cast<std::size_t>(j)] * zeta[static_cast<std::size_t>(j)];
-  if (continuity)
-    for (int i = row.first; i < emitted; ++i) e += row.c[static_cast<std::size_t>(i)] * c[static_cast<std::size_t>(i)];
+  Vec3 e = weighted_vector_sum(row.first, n - 1, [&](int j) { return row.zeta[static_cast<std::size_t>(j)]; }, zeta);
+  if (continuity) e += weighted_vector_sum(row.first, emitted, [&](int i) { return row.c[static_cast<std::size_t>(i)]; }, c);
   return e;
 }
 
 // (1 − f)·u_a + f·u_b in one pass over ζ (the adapted smoothing between two levels; no
 // continuity, which needs fixed smoothing).
 Vec3 apply_rows(const EmissionRow& a, const EmissionRow& b, double f, int n, std::span<const Vec3> zeta) {
-  Vec3 e = Vec3::Zero();
-  const int first = std::min(a.first, b.first);
-  for (int j = first; j < n - 1; ++j) {
-    const auto i = static_cast<std::size_t>(j);
-    e += ((1.0 - f) * a.zeta[i] + f * b.zeta[i]) * zeta[i];
-  }
-  return e;
+  const double g = 1.0 - f;
+  return weighted_vector_sum(
+      std::min(a.first, b.first), n - 1,
+      [&](int j) { return g * a.zeta[static_cast<std::size_t>(j)] + f * b.zeta[static_cast<std::size_t>(j)]; }, zeta);
 }
 
 }  // namespace

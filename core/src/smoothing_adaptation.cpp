@@ -1,6 +1,7 @@
 #include "posefair/core/smoothing_adaptation.hpp"
 
 #include "posefair/core/combinatorics.hpp"
+#include "posefair/core/weighted_vector_sum.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -80,10 +81,12 @@ void MotionNoiseEstimator::update_noise(double length, double dt) {
   noise_var_ = sigma * sigma;
 }
 
-void MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
+bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
   const int n1 = static_cast<int>(zeta.size());  // differences available
   const int k = order_ + 2;
-  if (!(dt > 0.0)) return;
+  if (!(dt > 0.0)) return false;
+  const bool was_ready = ready();
+  bool refreshed = false;
   if (n1 >= k - 1 + 1) {
     // D^kθ at the newest = D^{k−1} of the newest k differences.
     Vec3 d = Vec3::Zero();
@@ -93,19 +96,28 @@ void MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
     }
     update_noise(d.norm(), dt);
   }
+  // The fit is taken at most kMotionRefreshes times per motion_time_s (every 4 ms by default):
+  // the estimate averages over motion_time_s anyway, and fits a few samples apart share nearly
+  // all their samples, so at 1 kHz three fits in four would add nothing but their cost (a
+  // quarter of the engine's). At rates up to kMotionRefreshes / motion_time_s every sample fits.
   if (span_ > 0 && n1 >= span_ - 1) {
-    Vec3 d = Vec3::Zero();
-    const auto base = static_cast<std::size_t>(n1 - (span_ - 1));
-    for (int j = 0; j < span_ - 1; ++j) d += fit_[static_cast<std::size_t>(j)] * zeta[base + static_cast<std::size_t>(j)];
-    const double sample = d.squaredNorm() / 3.0;
-    const double alpha = motion_ready_ ? 1.0 - std::exp(-dt / settings_.motion_time_s) : 1.0;
-    mean_square_ += alpha * (sample - mean_square_);
-    motion_ready_ = true;
+    motion_pending_s_ += dt;
+    if (!motion_ready_ || motion_pending_s_ >= settings_.motion_time_s / kMotionRefreshes) {
+      const Vec3 d = weighted_vector_sum(0, span_ - 1, [&](int j) { return fit_[static_cast<std::size_t>(j)]; },
+                                         zeta.subspan(static_cast<std::size_t>(n1 - (span_ - 1))));
+      const double sample = d.squaredNorm() / 3.0;
+      const double alpha = motion_ready_ ? 1.0 - std::exp(-motion_pending_s_ / settings_.motion_time_s) : 1.0;
+      mean_square_ += alpha * (sample - mean_square_);
+      motion_ready_ = true;
+      motion_pending_s_ = 0.0;
+      refreshed = true;
+    }
   }
   if (motion_ready_) {
     const double fit_noise = noise_var_ * fit_noise_gain_;
     motion_var_ = std::max(settings_.motion_floor ? fit_noise : 0.0, mean_square_ - fit_noise);
   }
+  return refreshed || ready() != was_ready;
 }
 
 double best_level(std::span<const EmissionRow> rows, int count, double noise_var, double motion_var) {

@@ -55,8 +55,11 @@ class MotionNoiseEstimator {
   void configure(double rate_hz, const AdaptationSettings& settings);
 
   // After a new sample: zeta holds the window's n−1 differences, newest last; dt is the
-  // newest step (seconds). Differences across a window restart are never used.
-  void update(std::span<const Vec3> zeta, double dt);
+  // newest step (seconds). Differences across a window restart are never used. True when the
+  // motion estimate was refreshed or ready() changed (a choice of level made from the estimates
+  // before stays as good until then: the noise estimate moves by a step of dt/noise_time_s).
+  bool update(std::span<const Vec3> zeta, double dt);
+  static constexpr double kMotionRefreshes = 25.0;  // motion fits per motion_time_s, at most
 
   bool ready() const { return noise_count_ > 0 && motion_ready_; }
   double noise_variance() const { return noise_var_; }    // σ², per component, per sample
@@ -80,6 +83,7 @@ class MotionNoiseEstimator {
   // Motion.
   double mean_square_ = 0.0;
   bool motion_ready_ = false;
+  double motion_pending_s_ = 0.0;  // stream time since the fit was last taken
   double motion_var_ = 0.0;
 };
 
