@@ -102,7 +102,8 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
   // quarter of the engine's). At rates up to kMotionRefreshes / motion_time_s every sample fits.
   if (span_ > 0 && n1 >= span_ - 1) {
     motion_pending_s_ += dt;
-    if (!motion_ready_ || motion_pending_s_ >= settings_.motion_time_s / kMotionRefreshes) {
+    // (Less a rounding's worth: four steps of 1 ms may add up to just under 4 ms.)
+    if (!motion_ready_ || motion_pending_s_ >= (1.0 - 1e-9) * settings_.motion_time_s / kMotionRefreshes) {
       const Vec3 d = weighted_vector_sum(0, span_ - 1, [&](int j) { return fit_[static_cast<std::size_t>(j)]; },
                                          zeta.subspan(static_cast<std::size_t>(n1 - (span_ - 1))));
       const double sample = d.squaredNorm() / 3.0;

@@ -12,6 +12,7 @@
 #include "posefair/core/causal_fairing.hpp"
 #include "posefair/core/fairing_window.hpp"
 #include "posefair/core/quality_metrics.hpp"
+#include "posefair/core/smoothing_adaptation.hpp"
 #include "posefair/core/smoother_rows.hpp"
 
 namespace posefair {
@@ -122,6 +123,32 @@ TEST(RateIndependence, TheDefaultsAgreeAcrossRatesOnTheSameNoiseDensity) {
   for (std::size_t i = 1; i < cutoffs.size(); ++i) {
     EXPECT_NEAR(spans[i], 0.5, 0.01) << rates[i];
     EXPECT_LT(std::abs(std::log(cutoffs[i] / cutoffs[0])), std::log(1.5)) << rates[i] << " Hz: cutoff " << cutoffs[i] << " vs " << cutoffs[0];
+  }
+}
+
+// The motion fit is taken at most 25 times per motion time constant (0.1 s: every 4 ms): every
+// sample at 100 Hz, every 4th at 1 kHz, and the first time the window is long enough at once.
+TEST(Adaptation, TheMotionFitIsTakenEveryFourMillisecondsAtMost) {
+  for (const double rate : {100.0, 1000.0}) {
+    MotionNoiseEstimator estimator(128, 2);
+    estimator.configure(rate, AdaptationSettings{});
+    std::vector<Vec3> zeta;
+    std::mt19937 random(7);
+    std::normal_distribution<double> noise(0.0, 0.01);
+    int refreshes = 0, first = -1;
+    for (int i = 0; i < 400; ++i) {
+      if (zeta.size() == 127) zeta.erase(zeta.begin());
+      zeta.emplace_back(noise(random), noise(random), noise(random));
+      if (estimator.update(zeta, 1.0 / rate)) {
+        ++refreshes;
+        if (first < 0) first = i;
+      }
+    }
+    ASSERT_TRUE(estimator.ready()) << rate;
+    const int span = estimator.span();  // 25 samples at 100 Hz, 128 (the capacity) at 1 kHz
+    EXPECT_EQ(first, span - 2) << rate << " Hz: ready as soon as the fit has its span";
+    const int after = 400 - (span - 1);  // the samples after the first fit
+    EXPECT_EQ(refreshes - 1, rate == 100.0 ? after : after / 4) << rate << " Hz";
   }
 }
 
