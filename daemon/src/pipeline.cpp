@@ -474,8 +474,7 @@ bool Pipeline::stream_pass(Stream& s) {
   // A gyro_stream source first, when its role is free, so this pass has the readings up to the
   // samples it fairs (as the engine thread's order has them).
   if (s.gyro_source && config_.daemon.fair_on == FairThread::Driver) {
-    bool source_any = false;
-    if (fair_stream(*s.gyro_source, 1, source_any)) wake_engine();  // what is left: the engine thread's
+    if (fair_stream(*s.gyro_source, 1).left) wake_engine();  // what is left: the engine thread's
   }
   bool any = false;
   bool emitted = false;
@@ -538,8 +537,10 @@ bool Pipeline::stream_pass(Stream& s) {
 bool Pipeline::engine_pass() {
   heartbeat_.fetch_add(1, std::memory_order_relaxed);
   bool any = false;
-  for (Stream* sp : engine_order_)
-    if (fair_stream(*sp, 1, any)) any = true;
+  for (Stream* sp : engine_order_) {
+    const StreamFairing f = fair_stream(*sp, 1);
+    any = any || f.worked || f.left;
+  }
   return any;
 }
 
@@ -565,17 +566,19 @@ bool Pipeline::engine_work_pending(const Stream& s) const {
          (s.driver_done.load(std::memory_order_acquire) && !s.flushed.load(std::memory_order_relaxed));
 }
 
-// Passes s under its engine role until nothing is left for it, at most `rounds` times. Returns
-// false when done or when another thread holds the role (which then sees the work: see
-// take_engine_role); true when work is still left after the last round.
-bool Pipeline::fair_stream(Stream& s, int rounds, bool& any) {
+// Passes s under its engine role until nothing is left for it, at most `rounds` times. Nothing
+// is left to the caller when it is done or when another thread holds the role (which then sees
+// the work: see take_engine_role); `left` when work remains after the last round.
+Pipeline::StreamFairing Pipeline::fair_stream(Stream& s, int rounds) {
+  StreamFairing f;
   for (int round = 1; round <= rounds; ++round) {
-    if (!take_engine_role(s)) return false;
-    any = stream_pass(s) || any;
+    if (!take_engine_role(s)) return f;
+    f.worked = stream_pass(s) || f.worked;
     release_engine_role(s);
-    if (!engine_work_pending(s)) return false;
+    if (!engine_work_pending(s)) return f;
   }
-  return true;
+  f.left = true;
+  return f;
 }
 
 // A driver thread has just pushed a sample into s's ring. With fair_on = "driver" it fairs and
@@ -586,9 +589,8 @@ void Pipeline::handed_over(Stream& s) {
     wake_engine();
     return;
   }
-  bool any = false;
   if (hooks_.on_engine_role) hooks_.on_engine_role(true);
-  const bool left = fair_stream(s, kDriverPasses, any);
+  const bool left = fair_stream(s, kDriverPasses).left;
   if (hooks_.on_engine_role) hooks_.on_engine_role(false);
   if (left) wake_engine();
 }

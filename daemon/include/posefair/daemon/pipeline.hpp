@@ -113,7 +113,11 @@ class Pipeline {
   bool take_engine_role(Stream& s);
   void release_engine_role(Stream& s);
   bool engine_work_pending(const Stream& s) const;
-  bool fair_stream(Stream& s, int rounds, bool& any);
+  struct StreamFairing {
+    bool worked = false;  // a pass did something
+    bool left = false;    // work remains for the stream after the last round
+  };
+  StreamFairing fair_stream(Stream& s, int rounds);
   void handed_over(Stream& s);  // a driver thread has pushed a sample into its stream's ring
   static constexpr int kDriverPasses = 4;  // fair_on = "driver": passes a driver thread makes at most
   bool emit(Stream& s, const FairedPose& pose, std::uint64_t enqueued_ns);
