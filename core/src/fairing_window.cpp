@@ -381,6 +381,18 @@ void FairingWindow::linear_emission_estimate(int k, double dt) {
   if (positions_) xp_[static_cast<std::size_t>(k)] = zp_[static_cast<std::size_t>(k)] + linear_correction(pos_, dzp_, cp_);
 }
 
+// Constant angular (and linear) velocity from the last accepted measurement to the newest,
+// over their real time step, carried on for the horizon: what dead reckoning predicts. Before
+// the rate is known the window has no rows to predict with, and a window restarted by a gap
+// has a single sample; holding the measurement there would lag by the whole horizon.
+void FairingWindow::predict_from_last_step(int k, double step) {
+  if (!(step > 0.0)) return;
+  const auto i = static_cast<std::size_t>(k);
+  const double s = config_.horizon_s / step;
+  est_[i] = s * so3::log(so3::aligned_to(last_z_, z_[i]).conjugate() * z_[i]);
+  if (positions_ && last_has_position_) xp_[i] = zp_[i] + s * (zp_[i] - last_p_);
+}
+
 std::size_t FairingWindow::memory_bytes() const {
   std::size_t bytes = sizeof(*this);
   bytes += samples_.capacity() * sizeof(Sample);
@@ -461,7 +473,9 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
     count = emit_pending(out);
     ++counters_.restarts;
   }
-  const double dt = have_time_ && verdict == GateVerdict::Accept ? s.time - last_time_ : 0.0;
+  const double step = have_time_ ? s.time - last_time_ : 0.0;  // across a gap too
+  const double dt = verdict == GateVerdict::Accept ? step : 0.0;
+  const bool had_last = have_time_;
   last_time_ = s.time;
   have_time_ = true;
   append(s);
@@ -471,9 +485,15 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
     // Only the emitted sample's estimate is needed: one precomputed dot product (two while
     // the adapted smoothing lies between levels).
     linear_emission_estimate(k, dt);
+    // A prediction the window cannot make (its rate not yet known, or its only sample the
+    // first after a gap) is the last step carried on at its real duration: dead reckoning.
+    if (config_.horizon_s > 0.0 && k >= 0 && had_last && (!prepared_ || n_ == 1)) predict_from_last_step(k, step);
   } else {
     solve();
   }
+  last_z_ = z_[static_cast<std::size_t>(n_ - 1)];
+  last_p_ = s.position;
+  last_has_position_ = s.has_position();
   if (k >= 0) out[static_cast<std::size_t>(count++)] = emit(k);
   return count;
 }

@@ -161,6 +161,7 @@ class FairingWindow {
   void adapt(Channel& ch, std::span<const Vec3> zeta, double dt);
   Vec3 linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c);
   void linear_emission_estimate(int k, double dt);
+  void predict_from_last_step(int k, double step);
   void check_continuity_stability() const;
   void solve();
   void linear_window();
@@ -186,6 +187,11 @@ class FairingWindow {
   Quat last_emitted_ = Quat::Identity();
   double last_time_ = 0.0;
   bool have_time_ = false;
+  // The last accepted measurement, kept across a restart: a prediction the window cannot make
+  // yet extrapolates the step from it (predict_from_last_step).
+  Quat last_z_ = Quat::Identity();
+  Vec3 last_p_ = Vec3::Zero();
+  bool last_has_position_ = false;
 
   // The rate: given, or the median of the first kRateIntervals intervals.
   double rate_ = 0.0;
