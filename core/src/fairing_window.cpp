@@ -256,6 +256,10 @@ void FairingWindow::prepare(double rate_hz) {
         if (mu > kMaxSmoothing) break;
         builder_.build(w_, mu, target_spec_, levels_[static_cast<std::size_t>(level_count_++)]);
       }
+      const int emitted = w_ - 1 - config_.lag;
+      for (int l = 0; l + 1 < level_count_; ++l)
+        level_shared_gain_[static_cast<std::size_t>(l)] =
+            shared_noise_gain(levels_[static_cast<std::size_t>(l)], levels_[static_cast<std::size_t>(l + 1)], w_, emitted);
       rot_.estimator.configure(rate_hz, config_.adaptation);
       pos_.estimator.configure(rate_hz, config_.adaptation);
       AdaptationSettings aided = config_.adaptation;
@@ -279,7 +283,8 @@ void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
     return;
   }
   if (!refreshed) return;  // the level follows the motion estimate's refreshes
-  ch.level = best_level(levels_, level_count_, estimator.noise_variance(), config_.adaptation.motion_margin * estimator.motion_variance());
+  ch.level = best_level(levels_, level_shared_gain_, level_count_, estimator.noise_variance(),
+                        config_.adaptation.motion_margin * estimator.motion_variance());
   // The μ a window still filling uses, and the one reported: geometric between the levels
   // (linear from the pass-through level 0).
   const int i = static_cast<int>(ch.level);

@@ -43,6 +43,22 @@ void EmissionRowBuilder::correction_weights(int n, double mu, int k, std::span<d
   for (int j = 0; j < n - 1; ++j) hk[static_cast<std::size_t>(j)] = -mu * scratch_[static_cast<std::size_t>(j)].x();
 }
 
+namespace {
+
+// The weight of θ_i in the row's output: θ_k + Σ_j zeta_j (θ_{j+1} − θ_j), so δ_ik + zeta_{i−1} − zeta_i.
+double theta_weight(const EmissionRow& row, int n, int k, int i) {
+  const auto u = static_cast<std::size_t>(i);
+  return (i == k ? 1.0 : 0.0) + (i > 0 ? row.zeta[u - 1] : 0.0) - (i < n - 1 ? row.zeta[u] : 0.0);
+}
+
+}  // namespace
+
+double shared_noise_gain(const EmissionRow& a, const EmissionRow& b, int n, int k) {
+  double sum = 0.0;
+  for (int i = 0; i < n; ++i) sum += theta_weight(a, n, k, i) * theta_weight(b, n, k, i);
+  return sum;
+}
+
 bool EmissionRowBuilder::build(int n, double mu, const EmissionTarget& t, EmissionRow& row) {
   const int m = order_;
   const int k = n - 1 - t.lag;
@@ -74,19 +90,17 @@ bool EmissionRowBuilder::build(int n, double mu, const EmissionTarget& t, Emissi
     hz[static_cast<std::size_t>(k - 1)] += h + c2;
     if (second) hz[static_cast<std::size_t>(k - 2)] -= c2;
   }
-  // The weights on θ: the output is θ_k + Σ_j hz_j (θ_{j+1} − θ_j), so s_i = δ_ik + hz_{i−1} − hz_i.
+  // The weights on θ (theta_weight) give the row its error model.
   const double target = k + (h > 0.0 ? h : 0.0);
   const double mf = factorial(m);
-  double gain = 0.0, response = 0.0, largest = 0.0;
+  double response = 0.0, largest = 0.0;
   for (int i = 0; i < n; ++i) {
     const auto u = static_cast<std::size_t>(i);
-    const double s = (i == k ? 1.0 : 0.0) + (i > 0 ? hz[u - 1] : 0.0) - (i < n - 1 ? hz[u] : 0.0);
-    gain += s * s;
-    response += s * std::pow(i - k, m) / mf;
+    response += theta_weight(row, n, k, i) * std::pow(i - k, m) / mf;
     if (i < n - 1) largest = std::max(largest, std::abs(hz[u]));
     largest = std::max(largest, std::abs(hc[u]));
   }
-  row.noise_gain = gain;
+  row.noise_gain = shared_noise_gain(row, row, n, k);
   row.bias = response - std::pow(target - k, m) / mf;
   // Rows decay geometrically into the past: skip what cannot change a double's worth.
   const double negligible = 1e-12 * largest;

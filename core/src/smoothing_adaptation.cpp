@@ -121,7 +121,8 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
   return refreshed || ready() != was_ready;
 }
 
-double best_level(std::span<const EmissionRow> rows, int count, double noise_var, double motion_var) {
+double best_level(std::span<const EmissionRow> rows, std::span<const double> shared_gain, int count, double noise_var,
+                  double motion_var) {
   if (count <= 1) return 0.0;
   auto cost = [&](int l) {
     const EmissionRow& r = rows[static_cast<std::size_t>(l)];
@@ -136,11 +137,34 @@ double best_level(std::span<const EmissionRow> rows, int count, double noise_var
       best = l;
     }
   }
-  if (best == 0 || best == count - 1) return best;
-  const double a = cost(best - 1), b = best_cost, c = cost(best + 1);
-  const double curvature = a - 2.0 * b + c;
-  if (!(curvature > 0.0)) return best;
-  return best + std::clamp(0.5 * (a - c) / curvature, -0.5, 0.5);
+  // The stream passes unchanged unless a whole level pays: a blend with pass-through always
+  // gains noise to first order in f and loses bias only to second, so any noise estimate would
+  // buy some smoothing, and the estimate is where motion near Nyquist passes for noise
+  // (docs/engine.md, "Where it cannot help").
+  if (best == 0) return 0.0;
+  // The blend between levels l and l + 1: its expected error is a quadratic in f with
+  // c2 = σ²(G_l − 2G_{l,l+1} + G_{l+1}) + d²(B_{l+1} − B_l)² ≥ 0 (the variance of the rows'
+  // difference) and c1 = −2σ²(G_l − G_{l,l+1}) + 2d²B_l(B_{l+1} − B_l).
+  double level = best;
+  auto refine = [&](int l) {
+    if (l < 0 || l + 1 >= count) return;
+    const EmissionRow& a = rows[static_cast<std::size_t>(l)];
+    const EmissionRow& b = rows[static_cast<std::size_t>(l + 1)];
+    const double g = shared_gain[static_cast<std::size_t>(l)];
+    const double db = b.bias - a.bias;
+    const double c2 = noise_var * (a.noise_gain - 2.0 * g + b.noise_gain) + motion_var * db * db;
+    const double c1 = -2.0 * noise_var * (a.noise_gain - g) + 2.0 * motion_var * a.bias * db;
+    if (!(c2 > 0.0)) return;
+    const double f = std::clamp(-0.5 * c1 / c2, 0.0, 1.0);
+    const double c = cost(l) + c1 * f + c2 * f * f;
+    if (c < best_cost) {
+      best_cost = c;
+      level = l + f;
+    }
+  };
+  refine(best - 1);
+  refine(best);
+  return level;
 }
 
 }  // namespace posefair

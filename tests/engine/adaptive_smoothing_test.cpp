@@ -262,6 +262,59 @@ TEST(Adaptation, TheRateIsMeasuredAndTheWindowIsHalfASecond) {
   }
 }
 
+TEST(Adaptation, TheLevelIsTheBlendWithTheLeastExpectedError) {
+  // Levels as the engine makes them (pass-through, then cutoffs a third of an octave apart),
+  // for a plain output and a 20 ms prediction. Brute force over blends of neighbouring rows,
+  // each blended row's noise gain and bias taken from its own weights, must not find a lower
+  // expected error than best_level's choice. Where pass-through is the best whole level the
+  // stream passes unchanged (level 0 exactly).
+  const int w = 32, m = 2;
+  const double rate = 100.0;
+  for (double horizon : {0.0, 2.0}) {
+    EmissionTarget target;
+    target.order = m;
+    target.horizon = horizon;
+    EmissionRowBuilder builder(w, m);
+    std::vector<EmissionRow> rows;
+    rows.push_back(make_emission_row(w));
+    builder.build(w, 0.0, target, rows.back());
+    for (int j = 0; j < 12; ++j) {
+      rows.push_back(make_emission_row(w));
+      builder.build(w, smoothing_for_cutoff(0.45 * std::pow(2.0, -j / 3.0) * rate, rate, m), target, rows.back());
+    }
+    const int count = static_cast<int>(rows.size());
+    std::vector<double> shared(rows.size(), 0.0);
+    for (int l = 0; l + 1 < count; ++l) shared[static_cast<std::size_t>(l)] = shared_noise_gain(rows[l], rows[l + 1], w, w - 1);
+    EmissionRow blend = make_emission_row(w);
+    auto blended_cost = [&](double level, double noise_var, double motion_var) {
+      const int l = std::min(static_cast<int>(level), count - 2);
+      const double f = level - l;
+      for (int j = 0; j < w - 1; ++j) blend.zeta[j] = (1.0 - f) * rows[l].zeta[j] + f * rows[l + 1].zeta[j];
+      const double bias = (1.0 - f) * rows[l].bias + f * rows[l + 1].bias;
+      return noise_var * shared_noise_gain(blend, blend, w, w - 1) + motion_var * bias * bias;
+    };
+    int interior = 0;
+    for (double noise_var : {1e-6, 1e-4, 1e-2})
+      for (double motion_var : {1e-12, 1e-9, 1e-6, 1e-3}) {
+        const double chosen = best_level(rows, shared, count, noise_var, motion_var);
+        const double chosen_cost = blended_cost(chosen, noise_var, motion_var);
+        double whole_best = 0.0;
+        for (int l = 1; l < count; ++l)
+          if (blended_cost(l, noise_var, motion_var) < blended_cost(whole_best, noise_var, motion_var)) whole_best = l;
+        if (whole_best == 0.0) {
+          EXPECT_EQ(chosen, 0.0) << "h " << horizon << " noise " << noise_var << " motion " << motion_var;
+          continue;
+        }
+        if (chosen != std::round(chosen)) ++interior;
+        // Every blend within a level of the best whole one.
+        for (double level = std::max(0.0, whole_best - 1.0); level <= std::min<double>(count - 1, whole_best + 1.0); level += 0.001)
+          ASSERT_LE(chosen_cost, blended_cost(level, noise_var, motion_var) * (1.0 + 1e-9))
+              << "h " << horizon << " noise " << noise_var << " motion " << motion_var << ": level " << chosen << " against " << level;
+      }
+    EXPECT_GE(interior, 3) << "h " << horizon;  // the choice does fall between levels
+  }
+}
+
 TEST(EmissionRows, TheirBiasAndNoiseGainPredictTheEngine) {
   // Positions are linear, so the rows' error model is exact for them: a constant
   // acceleration a gives the error a·bias, white noise of variance 1 the variance noise_gain.

@@ -203,6 +203,7 @@ class FairingWindow {
   EmissionTarget target_spec_;
   EmissionRowBuilder builder_;
   std::vector<EmissionRow> levels_;  // candidate rows for the adaptation, least smoothing first
+  std::array<double, kMaxSmoothingLevels> level_shared_gain_{};  // [l]: shared_noise_gain of levels l, l + 1
   int level_count_ = 0;
   EmissionRow fill_row_;             // scratch: the row of a window still filling
   Channel rot_, pos_;

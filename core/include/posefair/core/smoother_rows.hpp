@@ -72,4 +72,9 @@ class EmissionRowBuilder {
 // Allocates a row able to hold windows of `capacity` samples.
 EmissionRow make_emission_row(int capacity);
 
+// Σ_i s_i t_i for the weights s and t that rows a and b (built for the same window of n samples
+// emitting sample k) put on θ: on white noise of variance σ² per component, the covariance of
+// their outputs is σ² times this (a row with itself: its noise_gain).
+double shared_noise_gain(const EmissionRow& a, const EmissionRow& b, int n, int k);
+
 }  // namespace posefair

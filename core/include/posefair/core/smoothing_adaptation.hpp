@@ -88,8 +88,11 @@ class MotionNoiseEstimator {
 };
 
 // The smoothing level (a real index into rows, ordered from least to most smoothing) with the
-// smallest expected squared error σ²·G + d²·B², refined between neighbours by a parabola in
-// the level index.
-double best_level(std::span<const EmissionRow> rows, int count, double noise_var, double motion_var);
+// smallest expected squared error σ²·G + d²·B². A fractional level l + f emits the blend
+// (1 − f)·u_l + f·u_{l+1}, whose bias (1 − f)B_l + f·B_{l+1} and noise gain
+// (1 − f)²G_l + 2f(1 − f)G_{l,l+1} + f²G_{l+1} are exact, so f is chosen exactly on both sides
+// of the best whole level. shared_gain[l] = G_{l,l+1} (shared_noise_gain of rows l and l + 1).
+double best_level(std::span<const EmissionRow> rows, std::span<const double> shared_gain, int count, double noise_var,
+                  double motion_var);
 
 }  // namespace posefair
