@@ -137,10 +137,10 @@ double best_level(std::span<const EmissionRow> rows, std::span<const double> sha
       best = l;
     }
   }
-  // The stream passes unchanged unless a whole level pays: a blend with pass-through always
-  // gains noise to first order in f and loses bias only to second, so any noise estimate would
-  // buy some smoothing, and the estimate is where motion near Nyquist passes for noise
-  // (docs/engine.md, "Where it cannot help").
+  // Level 0 (no smoothing: the measurement, or with a horizon dead reckoning) stays exact
+  // unless a whole level pays. Without a horizon a blend with level 0 gains noise to first order
+  // in f and pays bias only to second, so any noise estimate would buy some smoothing, and
+  // motion near Nyquist inflates that estimate (docs/engine.md, "Where it cannot help").
   if (best == 0) return 0.0;
   // The blend between levels l and l + 1: its expected error is a quadratic in f with
   // c2 = σ²(G_l − 2G_{l,l+1} + G_{l+1}) + d²(B_{l+1} − B_l)² ≥ 0 (the variance of the rows'
