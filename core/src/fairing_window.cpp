@@ -226,6 +226,17 @@ void FairingWindow::note_interval(double dt) {
   prepare(1.0 / sorted[kRateIntervals / 2]);
 }
 
+// The stream's interval: 1/rate once known, before that the median of the intervals so far
+// (0 before the first).
+double FairingWindow::typical_interval() const {
+  if (rate_ > 0.0) return 1.0 / rate_;
+  if (interval_count_ == 0) return 0.0;
+  std::array<double, kRateIntervals> sorted = intervals_;
+  const auto n = static_cast<std::ptrdiff_t>(interval_count_);
+  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.begin() + n);
+  return sorted[static_cast<std::size_t>(n / 2)];
+}
+
 // Settles W, the emission rows and the estimators for this rate (0: not needed). Runs once,
 // at construction or after the first intervals; the storage exists already, so it allocates nothing.
 void FairingWindow::prepare(double rate_hz) {
@@ -492,7 +503,11 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
     linear_emission_estimate(k, dt);
     // A prediction the window cannot make (its rate not yet known, or its only sample the
     // first after a gap) is the last step carried on at its real duration: dead reckoning.
-    if (config_.horizon_s > 0.0 && k >= 0 && had_last && (!prepared_ || n_ == 1)) predict_from_last_step(k, step);
+    // Never over a step shorter than the stream's interval (the rate, or before it is known the
+    // median of the intervals so far): a sample stamped just behind the last, as a burst of
+    // reports read together gets, would otherwise blow its noise up by horizon / step.
+    if (config_.horizon_s > 0.0 && k >= 0 && had_last && (!prepared_ || n_ == 1))
+      predict_from_last_step(k, std::max(step, typical_interval()));
   } else {
     solve();
   }

@@ -155,6 +155,7 @@ class FairingWindow {
   // What the rotation rows apply to: the measured increments ζ, or with a gyro their residual.
   const SlidingArray<Vec3>& rotation_increments() const { return aided_ ? residual_ : zeta_; }
   void note_interval(double dt);
+  double typical_interval() const;
   bool needs_rate() const;
   void prepare(double rate_hz);
   void slide(int count);
