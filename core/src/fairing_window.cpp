@@ -220,14 +220,11 @@ bool FairingWindow::needs_rate() const {
 void FairingWindow::note_interval(double dt) {
   if (prepared_ || !(dt > 0.0)) return;
   intervals_[static_cast<std::size_t>(interval_count_++)] = dt;
-  if (interval_count_ < kRateIntervals) return;
-  std::array<double, kRateIntervals> sorted = intervals_;
-  std::nth_element(sorted.begin(), sorted.begin() + kRateIntervals / 2, sorted.end());
-  prepare(1.0 / sorted[kRateIntervals / 2]);
+  if (interval_count_ == kRateIntervals) prepare(1.0 / typical_interval());
 }
 
 // The stream's interval: 1/rate once known, before that the median of the intervals so far
-// (0 before the first).
+// (0 before the first; after kRateIntervals of them, note_interval sets the rate from it).
 double FairingWindow::typical_interval() const {
   if (rate_ > 0.0) return 1.0 / rate_;
   if (interval_count_ == 0) return 0.0;
@@ -267,10 +264,10 @@ void FairingWindow::prepare(double rate_hz) {
         if (mu > kMaxSmoothing) break;
         builder_.build(w_, mu, target_spec_, levels_[static_cast<std::size_t>(level_count_++)]);
       }
-      const int emitted = w_ - 1 - config_.lag;
+      const int k = w_ - 1 - config_.lag;  // the emitted sample
       for (int l = 0; l + 1 < level_count_; ++l)
         level_shared_gain_[static_cast<std::size_t>(l)] =
-            shared_noise_gain(levels_[static_cast<std::size_t>(l)], levels_[static_cast<std::size_t>(l + 1)], w_, emitted);
+            shared_noise_gain(levels_[static_cast<std::size_t>(l)], levels_[static_cast<std::size_t>(l + 1)], w_, k);
       rot_.estimator.configure(rate_hz, config_.adaptation);
       pos_.estimator.configure(rate_hz, config_.adaptation);
       AdaptationSettings aided = config_.adaptation;
