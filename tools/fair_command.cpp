@@ -21,7 +21,7 @@
 #include "posefair/core/error.hpp"
 #include "posefair/core/causal_fairing.hpp"
 #include "posefair/core/fairing.hpp"
-#include "posefair/core/quality_metrics.hpp"
+#include "posefair/core/stream_rate.hpp"
 #include "posefair/formats/pose_file.hpp"
 
 namespace posefair::tools {
@@ -80,8 +80,8 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
   c.lambda_t = o.params.lambda_t;
   c.variant = o.params.variant;
   if (o.window_iterations) c.iterations = *o.window_iterations;
-  const double rate = median_sample_rate(in.time);
-  // A whole file is at hand: its median rate serves where a live stream would measure its first intervals.
+  const double rate = sample_rate(in.time);
+  // A whole file is at hand: its rate serves where a live stream would measure its first intervals.
   if (c.rate_hz == 0.0) c.rate_hz = rate;
   if (o.smoothing) c.smoothing_r = c.smoothing_t = *o.smoothing;
   try {
@@ -96,7 +96,7 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
   if (const int rc = write_output(o, file, r.poses); rc != kExitOk) return rc;
   if (!o.quiet) {
     const char* solver = c.solver == WindowSolver::Linear ? "linear" : c.solver == WindowSolver::GaussNewton ? "gauss-newton" : "sweeps";
-    print_input_line(o, file, "median", rate);
+    print_input_line(o, file, "sample", rate);
     const EngineState st = r.state;
     std::printf("causal   m=%d, %s solver, window %d (%.3g s at %.4g Hz), lag %d (%.3g ms), horizon %.3g ms, continuity %g, bound per %s\n",
                 c.order, solver, st.window, st.rate_hz > 0 ? st.window / st.rate_hz : 0.0, st.rate_hz, c.lag,
@@ -154,7 +154,7 @@ int run_fair(FairOptions o) {
     if (const int rc = write_output(o, file, r.poses); rc != kExitOk) return rc;
     if (!o.quiet) {
       const int m = o.params.order;
-      print_input_line(o, file, "median", median_sample_rate(in.time));
+      print_input_line(o, file, "sample", sample_rate(in.time));
       std::printf("fairing  m=%d, %s operators, lambda_r=%g lambda_t=%g, eps_r=%g rad eps_t=%g, cap %d\n", m,
                   o.params.variant == OperatorVariant::Printed ? "printed" : "corrected", o.params.lambda_r,
                   o.params.lambda_t, o.eps_r_rotation, o.params.epsilon_t, o.params.max_iterations);
@@ -226,7 +226,7 @@ void add_fair_command(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(1e-6, 60.0))
       ->capture_default_str()
       ->needs(causal);
-  cmd->add_option("--rate", o->window.rate_hz, "causal: the stream's rate in Hz (default: the file's median rate)")
+  cmd->add_option("--rate", o->window.rate_hz, "causal: the stream's rate in Hz (default: the file's, its median interval's or, if its samples come in clumps, its mean's)")
       ->check(CLI::NonNegativeNumber)
       ->needs(causal);
   cmd->add_option("--horizon", o->window.horizon_s, "causal: emit the pose predicted this many seconds past each sample (VR prediction)")
@@ -262,7 +262,7 @@ void add_fair_command(CLI::App& app, int& exit_code) {
       ->capture_default_str()
       ->needs(causal);
   cmd->add_option("--gap-intervals", o->window.gate.gap_intervals,
-                  "causal: a time step longer than this many of the stream's intervals also restarts the window (0: off)")
+                  "causal: a time step longer than this many of the stream's intervals, beyond what catches up with samples stamped in a clump, also restarts the window (0: off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str()
       ->needs(causal);

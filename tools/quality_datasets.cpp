@@ -15,6 +15,7 @@
 
 #include "benchmark_data.hpp"
 #include "posefair/core/quality_metrics.hpp"
+#include "posefair/core/stream_rate.hpp"
 #include "posefair/core/synthetic_motion.hpp"
 #include "posefair/formats/pose_file.hpp"
 
@@ -146,7 +147,7 @@ QualitySequence tum(const std::filesystem::path& est_path, const std::filesystem
     }
     q.input = std::move(d);
   }
-  q.rate_hz = median_sample_rate(q.input.time);
+  q.rate_hz = sample_rate(q.input.time);
   q.use.assign(q.input.size(), 1);
   return q;
 }
@@ -189,7 +190,7 @@ QualitySequence broad_sequence(const std::filesystem::path& path, const std::str
     q.gyro.emplace_back(v[8], v[9], v[10]);
     q.use.push_back(v[movement_col] > 0.5 ? 1 : 0);
   }
-  q.rate_hz = median_sample_rate(q.input.time);
+  q.rate_hz = sample_rate(q.input.time);
   // A rate interval is scored only if both ends are consecutive samples (no dropout between).
   for (std::size_t i = 0; i + 1 < q.input.size(); ++i)
     if (q.input.time[i + 1] - q.input.time[i] > 1.5 / q.rate_hz) q.use[i] = 0;
@@ -222,7 +223,7 @@ QualitySequence bvh(const std::filesystem::path& path, const std::string& joint,
     tt.push_back(clean.time[i]);
     tq.push_back(clean.orientation[i]);
   }
-  q.rate_hz = median_sample_rate(q.input.time);
+  q.rate_hz = sample_rate(q.input.time);
   q.truth = TruthTrack(std::move(tt), std::move(tq), 1.5 / q.rate_hz);
   q.use.assign(q.input.size(), 1);
   return q;

@@ -218,20 +218,13 @@ bool FairingWindow::needs_rate() const {
 }
 
 void FairingWindow::note_interval(double dt) {
-  if (prepared_ || !(dt > 0.0)) return;
-  intervals_[static_cast<std::size_t>(interval_count_++)] = dt;
-  if (interval_count_ == kRateIntervals) prepare(1.0 / typical_interval());
+  rate_estimate_.note(dt);
+  if (rate_estimate_.rate() > 0.0) prepare(rate_estimate_.rate());
 }
 
-// The stream's interval: 1/rate once known, before that the median of the intervals so far
-// (0 before the first; after kRateIntervals of them, note_interval sets the rate from it).
+// The stream's interval: 1/rate once known, before that the estimate's (stream_rate.hpp).
 double FairingWindow::typical_interval() const {
-  if (rate_ > 0.0) return 1.0 / rate_;
-  if (interval_count_ == 0) return 0.0;
-  std::array<double, kRateIntervals> sorted = intervals_;
-  const auto n = static_cast<std::ptrdiff_t>(interval_count_);
-  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.begin() + n);
-  return sorted[static_cast<std::size_t>(n / 2)];
+  return rate_ > 0.0 ? 1.0 / rate_ : rate_estimate_.typical_interval();
 }
 
 // Settles W, the emission rows and the estimators for this rate (0: not needed). Runs once,
@@ -501,10 +494,13 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
     // A prediction the window cannot make (its rate not yet known, or its only sample the
     // first after a gap) is the last step carried on at its real duration: dead reckoning.
     // Never over a step shorter than the stream's interval (the rate, or before it is known the
-    // median of the intervals so far): a sample stamped just behind the last, as a burst of
-    // reports read together gets, would otherwise blow its noise up by horizon / step.
-    if (config_.horizon_s > 0.0 && k >= 0 && had_last && (!prepared_ || n_ == 1))
-      predict_from_last_step(k, std::max(step, typical_interval()));
+    // estimate's): a sample stamped just behind the last, as a burst of reports read together
+    // gets, would otherwise blow its noise up by horizon / step; and while nothing says how
+    // long a step really took (the clump of a first read), not at all.
+    if (config_.horizon_s > 0.0 && k >= 0 && had_last && (!prepared_ || n_ == 1)) {
+      const double carried = std::max(step, typical_interval());
+      if (carried >= kShortestSampleInterval) predict_from_last_step(k, carried);
+    }
   } else {
     solve();
   }

@@ -136,15 +136,6 @@ FrameAlignment align_frames(std::span<const Quat> est, std::span<const Quat> tru
   return a;
 }
 
-double median_sample_rate(std::span<const double> time) {
-  std::vector<double> dt;
-  for (std::size_t i = 1; i < time.size(); ++i)
-    if (time[i] > time[i - 1]) dt.push_back(time[i] - time[i - 1]);
-  if (dt.empty()) return 0.0;
-  std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
-  return 1.0 / dt[dt.size() / 2];
-}
-
 Quat orientation_at(const PoseSequence& s, double t) {
   const auto& ts = s.time;
   if (t <= ts.front()) return s.orientation.front();

@@ -8,7 +8,7 @@
 
 namespace posefair {
 
-SampleGate::SampleGate(const GateConfig& config) : config_(config), gap_(config.gap_threshold) {
+SampleGate::SampleGate(const GateConfig& config) : config_(config) {
   if (!(config.unit_tolerance >= 0.0 && config.unit_tolerance < 1.0))
     throw InvalidEngineSetting(EngineSetting::UnitTolerance, "unit_tolerance must be in [0, 1)");
   if (!(config.gap_threshold > 0.0))
@@ -18,8 +18,8 @@ SampleGate::SampleGate(const GateConfig& config) : config_(config), gap_(config.
 }
 
 void SampleGate::set_interval(double interval) {
-  gap_ = config_.gap_threshold;
-  if (config_.gap_intervals > 0.0 && interval > 0.0) gap_ = std::min(gap_, config_.gap_intervals * interval);
+  interval_ = config_.gap_intervals > 0.0 && interval > 0.0 ? interval : 0.0;
+  ahead_ = 0.0;
 }
 
 GateVerdict SampleGate::check(Sample& s) {
@@ -50,7 +50,15 @@ GateVerdict SampleGate::check(Sample& s) {
     s.orientation.coeffs() /= norm;
     ++counters_.renormalised;
   }
-  const bool gap = s.time - last_time_ > gap_ && std::isfinite(last_time_);
+  bool gap = false;
+  if (std::isfinite(last_time_)) {
+    const double step = s.time - last_time_;
+    gap = step > config_.gap_threshold || (interval_ > 0.0 && step - ahead_ > config_.gap_intervals * interval_);
+    // A clump runs ahead of one sample per interval; the steps after it catch up. 5 % of the
+    // time that passes is forgiven, so a burst of stale samples at start-up, or a rate measured
+    // a little high, does not hide the gaps after it for long.
+    ahead_ = gap ? 0.0 : std::clamp(ahead_ + interval_ - 1.05 * step, 0.0, config_.gap_threshold);
+  }
   last_time_ = s.time;
   ++counters_.accepted;
   if (gap) {

@@ -128,6 +128,44 @@ TEST(RateIndependence, TheDefaultsAgreeAcrossRatesOnTheSameNoiseDensity) {
 
 // The motion fit is taken at most 25 times per motion time constant (0.1 s: every 4 ms): every
 // sample at 100 Hz, every 4th at 1 kHz, and the first time the window is long enough at once.
+TEST(RateIndependence, SamplesReadInClumpsAreSmoothedAndPredictedAsIfEvenlyStamped) {
+  // Samples stamped when a read delivers them, several per read 1 µs apart (a serial adapter's
+  // latency timer, a USB or BLE packet): the median interval is 1 µs. Measured from it, the rate
+  // was 1 MHz and the pause after each read a gap: the window restarted at every read, nothing
+  // was smoothed, and a 20 ms prediction extrapolated 1 µs steps by 20000 (1.5 rad off). The
+  // rate is the count over the elapsed time (stream_rate.hpp), and a pause that catches up with
+  // a clump is no gap (sample_gate.hpp): the output is what evenly stamped samples give.
+  struct Case {
+    double rate, read_period;
+  };
+  for (const Case c : {Case{200.0, 0.015}, Case{1000.0, 0.016}}) {
+    SCOPED_TRACE(std::to_string(c.rate) + " Hz read every " + std::to_string(c.read_period) + " s");
+    const double h = 0.02;
+    const Stream even = sampled(c.rate, 6.0, 0.01, 2.0);
+    PoseSequence clumped = even.input;
+    for (std::size_t i = 0; i < clumped.size(); ++i) {
+      clumped.time[i] = std::ceil(even.input.time[i] / c.read_period + 1e-9) * c.read_period;
+      if (i > 0 && clumped.time[i] <= clumped.time[i - 1]) clumped.time[i] = clumped.time[i - 1] + 1e-6;
+    }
+    const auto skip = static_cast<std::size_t>(2.0 * c.rate);  // a clumped rate is known after 1 s
+    std::vector<Quat> future;
+    for (double t : even.input.time) future.push_back(motion_at(t + h, 2.0));
+    WindowConfig now, ahead;
+    ahead.horizon_s = h;
+    const CausalResult a = fair_causal(clumped, now), b = fair_causal(clumped, ahead);
+    EXPECT_EQ(a.counters.restarts, 0u);
+    EXPECT_EQ(a.gate.gaps, 0u);
+    EXPECT_NEAR(a.state.rate_hz, c.rate, 0.03 * c.rate);
+    const double raw = rms_error(even.input.orientation, even.truth, skip);
+    const double smoothed_even = rms_error(fair_causal(even.input, now).poses.orientation, even.truth, skip);
+    const double smoothed = rms_error(a.poses.orientation, even.truth, skip);
+    EXPECT_LT(smoothed_even, 0.8 * raw);
+    EXPECT_LT(smoothed, 1.03 * smoothed_even);
+    const double predicted_even = rms_error(fair_causal(even.input, ahead).poses.orientation, future, skip);
+    EXPECT_LT(rms_error(b.poses.orientation, future, skip), 1.05 * predicted_even);
+  }
+}
+
 TEST(Adaptation, TheMotionFitIsTakenEveryFourMillisecondsAtMost) {
   for (const double rate : {100.0, 1000.0}) {
     MotionNoiseEstimator estimator(128, 2);

@@ -263,6 +263,42 @@ TEST(FairingWindowStream, APauseBelowTheGapThresholdDoesNotRestart) {
   }
 }
 
+TEST(FairingWindowStream, AStepOfMoreThanGapIntervalsRestartsUnlessItCatchesUpWithAClump) {
+  // Once the rate is known, a step longer than gap_intervals (4) intervals is a gap too: 4
+  // samples missing at 100 Hz are a 50 ms step, a restart; 2 missing (30 ms) are not.
+  const auto motion = noisy_motion(21, false, 300, 0.03);
+  WindowConfig c = config(WindowSolver::Linear, 0);
+  c.rate_hz = 100.0;
+  for (int missing : {2, 4}) {
+    std::vector<Sample> in = samples_from(motion.noisy);
+    in.erase(in.begin() + 100, in.begin() + 100 + missing);
+    FairingWindow w(c);
+    const auto out = run(w, in);
+    EXPECT_EQ(out.size(), in.size());
+    EXPECT_EQ(w.gate_counters().gaps, missing == 4 ? 1u : 0u) << missing << " missing";
+  }
+  // At 1 kHz, read 16 at a time every 16 ms and stamped 1 µs apart: the 16 ms pause after each
+  // read only catches up with the samples stamped ahead of one per interval, and is no gap. A
+  // lost read (32 ms without a sample) is.
+  c.rate_hz = 1000.0;
+  for (bool lose_a_read : {false, true}) {
+    std::vector<Sample> in;
+    for (int k = 0; k < 1600; ++k) {
+      if (lose_a_read && k >= 800 && k < 816) continue;
+      Sample s;
+      s.sequence = static_cast<std::uint64_t>(k);
+      s.orientation = so3::from_rotation_vector(Vec3(0.001 * k, 0.0, 0.0));
+      const double read = std::ceil((k / 1000.0) / 0.016 + 1e-9) * 0.016;
+      s.time = !in.empty() && read <= in.back().time ? in.back().time + 1e-6 : read;
+      in.push_back(s);
+    }
+    FairingWindow w(c);
+    const auto out = run(w, in);
+    EXPECT_EQ(out.size(), in.size());
+    EXPECT_EQ(w.gate_counters().gaps, lose_a_read ? 1u : 0u) << (lose_a_read ? "a read lost" : "every read");
+  }
+}
+
 TEST(FairingWindowStream, JitteredTimestampsAreAcceptedAndTreatedAsEvenlySpaced) {
   const auto motion = noisy_motion(17, true, 200, 0.03, 5.0);
   const auto regular = samples_from(motion.noisy);

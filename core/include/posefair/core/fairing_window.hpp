@@ -37,6 +37,7 @@
 #include "posefair/core/sliding_array.hpp"
 #include "posefair/core/smoother_rows.hpp"
 #include "posefair/core/smoothing_adaptation.hpp"
+#include "posefair/core/stream_rate.hpp"
 
 namespace posefair {
 
@@ -76,9 +77,8 @@ struct WindowConfig {
 
 // Largest accepted smoothing weight μ (see validate()).
 inline constexpr double kMaxSmoothing = 1e10;
-// The shortest window window_s may give, and the intervals that measure an unknown rate.
+// The shortest window window_s may give.
 inline constexpr int kMinWindowSamples = 8;
-inline constexpr int kRateIntervals = 8;
 // Candidate smoothing levels of the adaptation (a third of an octave of cutoff apart).
 inline constexpr int kMaxSmoothingLevels = 28;
 
@@ -194,11 +194,10 @@ class FairingWindow {
   Vec3 last_p_ = Vec3::Zero();
   bool last_has_position_ = false;
 
-  // The rate: given, or the median of the first kRateIntervals intervals.
+  // The rate: given, or measured from the first intervals (stream_rate.hpp).
   double rate_ = 0.0;
   bool prepared_ = false;  // W, the rows and the estimators are set for rate_
-  std::array<double, kRateIntervals> intervals_{};
-  int interval_count_ = 0;
+  StreamRateEstimate rate_estimate_;
 
   // Linear solver.
   EmissionTarget target_spec_;

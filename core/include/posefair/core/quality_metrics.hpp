@@ -55,10 +55,6 @@ struct FrameAlignment {
 };
 FrameAlignment align_frames(std::span<const Quat> est, std::span<const Quat> truth, bool fit_body);
 
-// The rate of the median positive sample interval (Hz): robust to gaps and repeated stamps.
-// 0 when there is no positive interval.
-double median_sample_rate(std::span<const double> time);
-
 // The orientation of a sequence at time t by slerp between its neighbours (clamped at the ends).
 Quat orientation_at(const PoseSequence& s, double t);
 

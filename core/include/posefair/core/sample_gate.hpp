@@ -9,6 +9,9 @@
 //     window must restart (the operators assume evenly spaced samples; a 100 ms dropout in a
 //     285 Hz stream is 28 missing samples, not one long step).
 // Sample times may jitter: the fairing operators treat consecutive samples as evenly spaced.
+// They may also come in clumps (several samples read together and stamped together): the
+// step after a clump only catches up with the samples that came ahead of one per interval,
+// and only what it takes beyond that counts against gap_intervals.
 #include <cstdint>
 #include <limits>
 
@@ -52,17 +55,21 @@ class SampleGate {
   // Checks s; on acceptance its orientation is normalised in place.
   GateVerdict check(Sample& s);
   // Forget the last time (a new stream), keep the counters.
-  void restart() { last_time_ = -std::numeric_limits<double>::infinity(); }
+  void restart() {
+    last_time_ = -std::numeric_limits<double>::infinity();
+    ahead_ = 0.0;
+  }
   const GateCounters& counters() const { return counters_; }
   const GateConfig& config() const { return config_; }
   // The stream's sample interval (seconds), once known: a step longer than gap_intervals of
-  // it is a gap as well. The longest step accepted without a restart is gap().
+  // it, beyond what catches up with a clump, is a gap as well.
   void set_interval(double interval);
-  double gap() const { return gap_; }
 
  private:
   GateConfig config_;
-  double gap_ = 0.0;
+  double interval_ = 0.0;  // 0: unknown, or gap_intervals off
+  // How far the samples since the last gap have come ahead of one per interval (a clump).
+  double ahead_ = 0.0;
   GateCounters counters_;
   double last_time_ = -std::numeric_limits<double>::infinity();
 };
