@@ -166,6 +166,7 @@ FairingWindow::FairingWindow(const WindowConfig& config)
       aided_estimator_(capacity_, config.order) {
   const auto w = static_cast<std::size_t>(capacity_);
   samples_.resize(w);
+  sampled_step_.resize(w);
   z_.resize(w);
   x_.resize(w);
   zeta_.resize(w);
@@ -406,7 +407,7 @@ std::size_t FairingWindow::memory_bytes() const {
   bytes += (zeta_.capacity() + residual_.capacity() + est_.capacity() + c_.capacity() + dzp_.capacity() + cp_.capacity()) * sizeof(Vec3);
   bytes += (zp_.capacity() + xp_.capacity() + yp_.capacity() + e_.capacity() + u_.capacity() + w_scratch_.capacity() +
             rhs_.capacity()) * sizeof(Vec3);
-  bytes += diag_.capacity() * sizeof(double) + window_clamped_.capacity();
+  bytes += (diag_.capacity() + sampled_step_.capacity()) * sizeof(double) + window_clamped_.capacity();
   auto row_bytes = [](const EmissionRow& r) { return (r.zeta.capacity() + r.c.capacity()) * sizeof(double); };
   bytes += levels_.capacity() * sizeof(EmissionRow);
   for (const EmissionRow& r : levels_) bytes += row_bytes(r);
@@ -452,6 +453,7 @@ FairedPose FairingWindow::emit(int index) {
   out.measured = s.orientation;
   out.measured_position = s.position;
   out.flags = s.flags | (clamped ? kClamped : 0u);
+  out.step = sampled_step_[k];
   return out;
 }
 
@@ -515,6 +517,7 @@ void FairingWindow::slide(int count) {
   // Drop the oldest `count` samples (emitted long ago): O(1) on average (sliding_array.hpp).
   auto drop = [&](auto& v) { v.drop_front(static_cast<std::size_t>(count), static_cast<std::size_t>(n_)); };
   drop(samples_);
+  drop(sampled_step_);
   drop(z_);
   if (config_.solver == WindowSolver::Linear) {
     drop(zeta_);
@@ -556,6 +559,7 @@ void FairingWindow::append(const Sample& s) {
   if (n_ == w_) slide(1);
   const auto k = static_cast<std::size_t>(n_);
   samples_[k] = s;
+  sampled_step_[k] = gate_.sampled_step();
   window_clamped_[k] = 0;
   Quat z = s.orientation;
   if (n_ == 0) {

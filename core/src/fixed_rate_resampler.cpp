@@ -82,6 +82,7 @@ std::size_t FixedRateResampler::push(const FairedPose& pose, std::span<FairedPos
     g.position = (g.flags & kHasPosition) ? p.position : Vec3::Zero();
     g.measured = g.orientation;  // nothing was measured at a grid time
     g.measured_position = g.position;
+    g.step = 0.0;  // nor sampled: the grid's own spacing is the step
   }
   return n;
 }
@@ -124,6 +125,7 @@ std::size_t FixedRateResampler::push_lerp(const FairedPose& pose, std::span<Fair
     if (!position) g.position = Vec3::Zero();
     g.measured = g.orientation;  // nothing was measured at a grid time
     g.measured_position = g.position;
+    g.step = 0.0;  // nor sampled: the grid's own spacing is the step
   }
   return n;
 }

@@ -51,9 +51,11 @@ GateVerdict SampleGate::check(Sample& s) {
     ++counters_.renormalised;
   }
   bool gap = false;
+  sampled_step_ = 0.0;
   if (std::isfinite(last_time_)) {
     const double step = s.time - last_time_;
     gap = step > config_.gap_threshold || (interval_ > 0.0 && step - ahead_ > config_.gap_intervals * interval_);
+    sampled_step_ = gap || interval_ == 0.0 ? step : std::max(interval_, step - ahead_);
     // A clump runs ahead of one sample per interval; the steps after it catch up. 5 % of the
     // time that passes is forgiven, so a burst of stale samples at start-up, or a rate measured
     // a little high, does not hide the gaps after it for long.

@@ -71,9 +71,12 @@ Publisher::Result Publisher::publish(const RingPose& pose) {
   if (pose.flags & kBridged) m.flags |= kFlagBridged;
   // Body rate between consecutive emitted poses: q_prev⁻¹ q = exp(ω dt / 2) in the papers'
   // half-angle convention, so ω = 2 log(q_prev⁻¹ q) / dt (the stream is hemisphere-continuous).
+  // dt is the time the samples were taken apart (FairedPose::step): samples read together and
+  // stamped 1 µs apart are still an interval apart. A resampled pose has none: its grid step.
   std::optional<Vec3> rate;
-  if (st.have_previous && pose.time > st.previous_time)
-    rate = 2.0 * so3::log(st.previous.conjugate() * m.orientation) / (pose.time - st.previous_time);
+  const double dt = pose.step > 0.0 ? pose.step : pose.time - st.previous_time;
+  if (st.have_previous && pose.time > st.previous_time && dt > 0.0)
+    rate = 2.0 * so3::log(st.previous.conjugate() * m.orientation) / dt;
   st.have_previous = true;
   st.previous_time = pose.time;
   st.previous = m.orientation;

@@ -579,6 +579,46 @@ TEST(Pipeline, RawSamplesWithAFusionStageAreFusedFairedAndPublished) {
 // with the gyro by default, and the bias and offset it estimates reach the stats, the counter
 // line and STATUS=. With `gyro_aided = false` the same stream is faired alone, and its error
 // against the true motion is at least twice as large.
+// Receive times of a 200 Hz tracker read every 15 ms: three samples per read, stamped 1 µs
+// apart. The published body rate is the rotation over the time the samples were taken apart
+// (one interval), not over their stamps' 1 µs, which made it 5000 times too fast.
+TEST(Pipeline, TheBodyRateOfSamplesStampedInClumpsIsOverTheirInterval) {
+  ScratchDir dir;
+  const Vec3 omega(0.3, -0.4, 2.0);  // rad/s, constant: the engine passes the motion unchanged
+  std::vector<Sample> clumped;
+  for (int k = 0; k < 800; ++k) {
+    Sample s;
+    s.stream_id = 1;
+    s.sequence = static_cast<std::uint64_t>(k);
+    const double sampled = k / 200.0;
+    s.orientation = so3::exp(0.5 * sampled * omega);  // half-angle convention
+    const double read = std::ceil(sampled / 0.015 + 1e-9) * 0.015;
+    s.time = !clumped.empty() && read <= clumped.back().time ? clumped.back().time + 1e-6 : read;
+    clumped.push_back(s);
+  }
+  write_imu_log(dir / "in.pflog", clumped);
+  UdpCollector receiver;
+  const std::string text = "[[stream]]\nid = 1\nname = \"tracker\"\nring_capacity = 4096\n"
+                           "[stream.driver]\ntype = \"replay\"\npath = \"" +
+                           (dir / "in.pflog").string() + "\"\ntiming = \"fast\"\n"
+                           "\n[[output]]\nangular_velocity = true\ndestinations = [\"127.0.0.1:" + std::to_string(receiver.port()) + "\"]\n";
+  const StreamStats st = run_to_end(parse_config(text, "/virtual/clumped.toml"));
+  EXPECT_EQ(st.restarts, 0u);
+  EXPECT_NEAR(st.engine.rate_hz, 200.0, 3.0);
+  receiver.drain();
+  const std::vector<PoseMessage> got = receiver.messages();
+  ASSERT_EQ(got.size(), clumped.size());
+  std::size_t checked = 0;
+  for (const PoseMessage& m : got) {
+    if (m.sample_time < 1.1) continue;  // a clumped stream's rate is measured over its first second
+    ASSERT_TRUE(m.angular_velocity) << m.sequence;
+    // The measured rate is the count over the elapsed time: within the 15 ms of a read per second.
+    EXPECT_LT((*m.angular_velocity - omega).norm(), 0.02 * omega.norm()) << m.sequence << ": " << m.angular_velocity->transpose();
+    ++checked;
+  }
+  EXPECT_GT(checked, 500u);
+}
+
 TEST(Pipeline, OrientationWithAGyroIsFairedWithTheGyroAndItsEstimatesAreReported) {
   ScratchDir dir;
   posefair::testing::GyroTrackerSpec spec;

@@ -276,6 +276,9 @@ TEST(FairingWindowStream, AStepOfMoreThanGapIntervalsRestartsUnlessItCatchesUpWi
     const auto out = run(w, in);
     EXPECT_EQ(out.size(), in.size());
     EXPECT_EQ(w.gate_counters().gaps, missing == 4 ? 1u : 0u) << missing << " missing";
+    // Each pose says how long after the previous its sample was taken: one interval, and the
+    // whole step where samples are missing.
+    for (std::size_t i = 1; i < out.size(); ++i) EXPECT_NEAR(out[i].step, i == 100 ? 0.01 * (missing + 1) : 0.01, 1e-9) << i;
   }
   // At 1 kHz, read 16 at a time every 16 ms and stamped 1 µs apart: the 16 ms pause after each
   // read only catches up with the samples stamped ahead of one per interval, and is no gap. A
@@ -296,6 +299,12 @@ TEST(FairingWindowStream, AStepOfMoreThanGapIntervalsRestartsUnlessItCatchesUpWi
     const auto out = run(w, in);
     EXPECT_EQ(out.size(), in.size());
     EXPECT_EQ(w.gate_counters().gaps, lose_a_read ? 1u : 0u) << (lose_a_read ? "a read lost" : "every read");
+    // Samples stamped 1 µs apart were still taken an interval apart; after the gap, the step is
+    // the stamped one.
+    for (std::size_t i = 1; i < out.size(); ++i) {
+      const bool after_gap = lose_a_read && out[i].sequence == 816;
+      EXPECT_NEAR(out[i].step, after_gap ? in[i].time - in[i - 1].time : 0.001, after_gap ? 0.0 : 2e-5) << i;
+    }
   }
 }
 

@@ -214,6 +214,7 @@ class FairingWindow {
 
   // Per sample, index 0 = oldest.
   SlidingArray<Sample> samples_;   // as accepted (time, ids, measured values with their own sign)
+  SlidingArray<double> sampled_step_;  // the gate's sampled_step() of each
   SlidingArray<Quat> z_;           // measurement, hemisphere-continuous
   SlidingArray<Quat> x_;           // current estimate (iterative solvers)
   SlidingArray<Vec3> zeta_;        // ζ_j = log(z_j⁻¹ z_{j+1}) (Linear)

@@ -52,6 +52,9 @@ struct FairedPose {
   Quat measured = Quat::Identity();     // the input as given (its own sign), normalised
   Vec3 measured_position = Vec3::Zero();
   std::uint32_t flags = 0;              // the sample's flags, plus kClamped
+  // How long after the previous pose's sample this one's was taken (SampleGate::sampled_step):
+  // the stamped step, but one interval for a sample stamped in a clump; 0 for a stream's first.
+  double step = 0.0;
 };
 
 }  // namespace posefair

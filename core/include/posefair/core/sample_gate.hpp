@@ -58,18 +58,25 @@ class SampleGate {
   void restart() {
     last_time_ = -std::numeric_limits<double>::infinity();
     ahead_ = 0.0;
+    sampled_step_ = 0.0;
   }
   const GateCounters& counters() const { return counters_; }
   const GateConfig& config() const { return config_; }
   // The stream's sample interval (seconds), once known: a step longer than gap_intervals of
   // it, beyond what catches up with a clump, is a gap as well.
   void set_interval(double interval);
+  // How long after the previous accepted sample the last one was taken, as far as the stamps
+  // tell: its stamped step less what that catches up with a clump, and at least the interval
+  // once that is known; after a gap, or while the interval is unknown, the stamped step; 0 for
+  // the first sample.
+  double sampled_step() const { return sampled_step_; }
 
  private:
   GateConfig config_;
   double interval_ = 0.0;  // 0: unknown, or gap_intervals off
   // How far the samples since the last gap have come ahead of one per interval (a clump).
   double ahead_ = 0.0;
+  double sampled_step_ = 0.0;
   GateCounters counters_;
   double last_time_ = -std::numeric_limits<double>::infinity();
 };

@@ -29,6 +29,7 @@ struct RingPose {
   std::uint32_t stream_index;  // index into the pipeline's stream table (not the wire id)
   std::uint32_t flags;         // the sample's flags plus kClamped
   double time;
+  double step;                 // FairedPose::step (0: take the time since the previous pose)
   double q[4];
   double p[3];
   std::uint64_t enqueued_ns;   // hand-over time of the sample whose arrival emitted this pose
@@ -77,6 +78,7 @@ inline RingPose pack(const FairedPose& f, std::uint32_t stream_index, std::uint6
   return RingPose{stream_index,
                   f.flags,
                   f.time,
+                  f.step,
                   {f.orientation.w(), f.orientation.x(), f.orientation.y(), f.orientation.z()},
                   {f.position.x(), f.position.y(), f.position.z()},
                   enqueued_ns,
