@@ -80,12 +80,14 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
   c.lambda_t = o.params.lambda_t;
   c.variant = o.params.variant;
   if (o.window_iterations) c.iterations = *o.window_iterations;
+  // Unless --rate gives it, the engine measures the rate as it does for a live stream, and
+  // follows it if it changes; the file's own rate is reported, and checks a --cutoff.
   const double rate = sample_rate(in.time);
-  // A whole file is at hand: its rate serves where a live stream would measure its first intervals.
-  if (c.rate_hz == 0.0) c.rate_hz = rate;
   if (o.smoothing) c.smoothing_r = c.smoothing_t = *o.smoothing;
   try {
-    validate(c);
+    WindowConfig at_file_rate = c;
+    if (at_file_rate.rate_hz == 0.0) at_file_rate.rate_hz = rate;
+    validate(at_file_rate);
   } catch (const std::invalid_argument& e) {
     std::cerr << "posefair fair: " << e.what() << "\n";
     return exit_code(ErrorKind::Usage);
@@ -226,7 +228,7 @@ void add_fair_command(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(1e-6, 60.0))
       ->capture_default_str()
       ->needs(causal);
-  cmd->add_option("--rate", o->window.rate_hz, "causal: the stream's rate in Hz (default: the file's, its median interval's or, if its samples come in clumps, its mean's)")
+  cmd->add_option("--rate", o->window.rate_hz, "causal: the stream's rate in Hz, fixed (default: measured from the first intervals and followed, as posefaird does)")
       ->check(CLI::NonNegativeNumber)
       ->needs(causal);
   cmd->add_option("--horizon", o->window.horizon_s, "causal: emit the pose predicted this many seconds past each sample (VR prediction)")

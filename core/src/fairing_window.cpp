@@ -15,6 +15,9 @@
 namespace posefair {
 namespace {
 
+// How far a measured rate may be left (as a ratio, either way) before the window follows.
+constexpr double kRateChange = 1.5;
+
 // Moves x onto the ball of radius eps around z (distance on S³ for rotations) if it is outside,
 // and checks the result with the same distance the promise is stated in: the radius is shrunk
 // step by step until rounding can no longer carry the result past eps (an absolute rounding of
@@ -205,7 +208,8 @@ FairingWindow::FairingWindow(const WindowConfig& config)
       }
     }
   }
-  if (config.rate_hz > 0.0 || !needs_rate()) prepare(config.rate_hz);
+  rate_measured_ = config.rate_hz == 0.0 && needs_rate();
+  if (!rate_measured_) prepare(config.rate_hz);
   if (config.continuity > 0.0) {
     if (!linear) builder_.build(config.window, rot_.mu, target_spec_, rot_.fixed);
     check_continuity_stability();
@@ -223,13 +227,35 @@ void FairingWindow::note_interval(double dt) {
   if (rate_estimate_.rate() > 0.0) prepare(rate_estimate_.rate());
 }
 
+// A measured rate the stream has left: two blocks of kMaxRateIntervals steps in a row whose
+// rates agree with each other and differ from it by more than kRateChange either way (jitter
+// moves a block's median by a few per cent, a stream that changes its rate by that ratio).
+// Steps the gate calls gaps count too, up to gap_threshold: at a quarter of the rate every
+// step is gap_intervals long. Returns the new rate, or 0.
+double FairingWindow::rate_change(double step) {
+  if (!(step > 0.0) || step > config_.gate.gap_threshold) return 0.0;
+  rate_check_.note(step);
+  const double r = rate_check_.rate();
+  if (r == 0.0) return 0.0;
+  rate_check_ = StreamRateEstimate(kMaxRateIntervals);
+  const auto within = [](double a, double b, double ratio) { return a < ratio * b && b < ratio * a; };
+  if (within(r, rate_, kRateChange)) {
+    rate_candidate_ = 0.0;
+    return 0.0;
+  }
+  const bool confirmed = rate_candidate_ > 0.0 && within(r, rate_candidate_, 1.25);
+  rate_candidate_ = confirmed ? 0.0 : r;
+  return confirmed ? r : 0.0;
+}
+
 // The stream's interval: 1/rate once known, before that the estimate's (stream_rate.hpp).
 double FairingWindow::typical_interval() const {
   return rate_ > 0.0 ? 1.0 / rate_ : rate_estimate_.typical_interval();
 }
 
-// Settles W, the emission rows and the estimators for this rate (0: not needed). Runs once,
-// at construction or after the first intervals; the storage exists already, so it allocates nothing.
+// Settles W, the emission rows and the estimators for this rate (0: not needed). Runs at
+// construction or after the first intervals, and again, on an empty window, when a measured rate
+// changes; the storage exists already, so it allocates nothing.
 void FairingWindow::prepare(double rate_hz) {
   rate_ = rate_hz;
   if (rate_hz > 0.0) gate_.set_interval(1.0 / rate_hz);
@@ -473,15 +499,17 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   const GateVerdict verdict = gate_.check(s);
   if (verdict != GateVerdict::Accept && verdict != GateVerdict::AcceptAfterGap) return 0;
   int count = 0;
-  // A gap, or a change between samples with and without positions or gyro, starts a new window;
-  // a gyro-aided window bridges a few missing readings instead (gyro_aiding.hpp).
+  const double step = have_time_ ? s.time - last_time_ : 0.0;  // across a gap too
+  const double new_rate = prepared_ && rate_measured_ ? rate_change(step) : 0.0;
+  // A gap, a change of rate, or a change between samples with and without positions or gyro,
+  // starts a new window; a gyro-aided window bridges a few missing readings instead (gyro_aiding.hpp).
   const bool bridge = aided_ && missing_gyro_run_ < kMaxBridgedGyroReadings;
-  if (n_ > 0 && (verdict == GateVerdict::AcceptAfterGap || s.has_position() != positions_ ||
+  if (n_ > 0 && (verdict == GateVerdict::AcceptAfterGap || new_rate > 0.0 || s.has_position() != positions_ ||
                  (gyro_aided(s) != aided_ && !bridge))) {
     count = emit_pending(out);
     ++counters_.restarts;
   }
-  const double step = have_time_ ? s.time - last_time_ : 0.0;  // across a gap too
+  if (new_rate > 0.0) prepare(new_rate);
   const double dt = verdict == GateVerdict::Accept ? step : 0.0;
   const bool had_last = have_time_;
   last_time_ = s.time;

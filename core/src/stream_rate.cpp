@@ -37,13 +37,15 @@ double sample_rate(std::span<const double> time, double gap) {
   return 1.0 / upper_median(dt);
 }
 
+StreamRateEstimate::StreamRateEstimate(int intervals) : intervals_(std::clamp(intervals, 1, kMaxRateIntervals)) {}
+
 void StreamRateEstimate::note(double dt) {
   if (rate_ > 0.0 || !(dt > 0.0)) return;
-  if (count_ < kRateIntervals) first_[static_cast<std::size_t>(count_)] = dt;
+  if (count_ < intervals_) first_[static_cast<std::size_t>(count_)] = dt;
   ++count_;
   sum_ += dt;
-  if (count_ == kRateIntervals) {
-    clumped_ = intervals_are_clumped(first_);
+  if (count_ == intervals_) {
+    clumped_ = intervals_are_clumped(std::span(first_).first(static_cast<std::size_t>(intervals_)));
     if (!clumped_) rate_ = 1.0 / typical_interval();
   }
   if (clumped_ && sum_ >= kClumpedRateSpan) rate_ = static_cast<double>(count_) / sum_;
@@ -52,12 +54,12 @@ void StreamRateEstimate::note(double dt) {
 double StreamRateEstimate::typical_interval() const {
   if (rate_ > 0.0) return 1.0 / rate_;
   if (count_ == 0) return 0.0;
-  const auto n = static_cast<std::size_t>(std::min<long>(count_, kRateIntervals));
+  const auto n = static_cast<std::size_t>(std::min<long>(count_, intervals_));
   if (clumped_ || intervals_are_clumped(std::span(first_).first(n))) {
     const double mean = sum_ / static_cast<double>(count_);
     return mean < kShortestSampleInterval ? 0.0 : mean;
   }
-  std::array<double, kRateIntervals> sorted = first_;
+  std::array<double, kMaxRateIntervals> sorted = first_;
   return upper_median(std::span(sorted).first(n));
 }
 

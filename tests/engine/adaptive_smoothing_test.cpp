@@ -166,6 +166,66 @@ TEST(RateIndependence, SamplesReadInClumpsAreSmoothedAndPredictedAsIfEvenlyStamp
   }
 }
 
+// `seconds_before` of the motion at rate `before`, then `seconds_after` at `after`; truth alike.
+Stream two_rates(double before, double after, double seconds_before, double seconds_after) {
+  const Stream a = sampled(before, seconds_before, 0.01, 2.0, 11);
+  Stream b = sampled(after, seconds_before + seconds_after, 0.01, 2.0, 12);
+  Stream s = a;
+  for (std::size_t i = 0; i < b.input.size(); ++i) {
+    if (b.input.time[i] < seconds_before) continue;
+    s.input.time.push_back(b.input.time[i]);
+    s.input.orientation.push_back(b.input.orientation[i]);
+    s.truth.push_back(b.truth[i]);
+  }
+  return s;
+}
+
+TEST(RateIndependence, AStreamThatChangesItsRateIsFollowed) {
+  // A measured rate is checked on in blocks of 32 steps. At a quarter of the old rate every step
+  // was a gap (the window restarted at each sample and smoothed nothing), at four times it the
+  // 20 ms prediction reached 5 ms ahead. The window restarts once at the new rate and from
+  // then on is what a stream at that rate all along gives.
+  for (const auto& [before, after] : {std::pair{50.0, 200.0}, std::pair{200.0, 50.0}}) {
+    SCOPED_TRACE(std::to_string(before) + " Hz, then " + std::to_string(after) + " Hz");
+    const Stream changed = two_rates(before, after, 2.0, 8.0);
+    const Stream steady = two_rates(after, after, 2.0, 8.0);
+    WindowConfig now, ahead;
+    ahead.horizon_s = 0.02;
+    const CausalResult a = fair_causal(changed.input, now);
+    EXPECT_NEAR(a.state.rate_hz, after, 1e-6 * after);
+    EXPECT_LE(a.counters.restarts, 1u + (after < before ? 2u * kMaxRateIntervals : 0u));
+    // From 4 s on (the change is followed within 64 steps, and the window has filled again).
+    auto error_after = [](const Stream& s, const std::vector<Quat>& out, double horizon) {
+      std::vector<char> use(out.size(), 0);
+      std::vector<Quat> truth(out.size());
+      for (std::size_t i = 0; i < out.size(); ++i) {
+        use[i] = s.input.time[i] >= 4.0;
+        truth[i] = motion_at(s.input.time[i] + horizon, 2.0);
+      }
+      return rotation_error(out, truth, use).rms;
+    };
+    const double smoothed = error_after(changed, a.poses.orientation, 0.0);
+    const double smoothed_steady = error_after(steady, fair_causal(steady.input, now).poses.orientation, 0.0);
+    EXPECT_LT(smoothed, 1.03 * smoothed_steady);
+    const double predicted = error_after(changed, fair_causal(changed.input, ahead).poses.orientation, 0.02);
+    const double predicted_steady = error_after(steady, fair_causal(steady.input, ahead).poses.orientation, 0.02);
+    EXPECT_LT(predicted, 1.03 * predicted_steady);
+  }
+}
+
+TEST(RateIndependence, JitteredTimesDoNotChangeAMeasuredRate) {
+  // ±40 % of the interval on every stamp for a minute: each block's median moves by a few per
+  // cent, never by the 1.5× a change of rate needs.
+  Stream s = sampled(100.0, 60.0, 0.01, 2.0);
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> jitter(-0.004, 0.004);
+  for (double& t : s.input.time) t += jitter(rng);
+  for (std::size_t i = 1; i < s.input.size(); ++i) s.input.time[i] = std::max(s.input.time[i], s.input.time[i - 1] + 1e-6);
+  const CausalResult r = fair_causal(s.input, WindowConfig{});
+  EXPECT_EQ(r.counters.restarts, 0u);
+  EXPECT_NEAR(r.state.rate_hz, 100.0, 10.0);
+}
+
 TEST(Adaptation, TheMotionFitIsTakenEveryFourMillisecondsAtMost) {
   for (const double rate : {100.0, 1000.0}) {
     MotionNoiseEstimator estimator(128, 2);

@@ -8,7 +8,6 @@
 #include "cli_runner.hpp"
 #include "posefair/core/causal_fairing.hpp"
 #include "posefair/core/fairing_window.hpp"
-#include "posefair/core/stream_rate.hpp"
 #include "posefair/core/synthetic_motion.hpp"
 #include "posefair/formats/pose_file.hpp"
 
@@ -79,9 +78,8 @@ TEST(CausalCommand, EqualsTheEngineCalledDirectly) {
       EXPECT_THAT(r.out, HasSubstr("400 emitted"));
       // The file as the CLI read it (values round-trip exactly), through the engine directly.
       const PoseSequence read_back = formats::read_pose_file(in_path, {}).poses();
-      // The CLI gives the engine the file's rate, which a live stream would measure.
-      WindowConfig config = c.config;
-      config.rate_hz = sample_rate(read_back.time);
+      // The engine measures the rate as for a live stream.
+      const WindowConfig config = c.config;
       const CausalResult direct = fair_causal(read_back, config);
       const PoseSequence cli = formats::read_pose_file(out_path, {}).poses();
       ASSERT_EQ(cli.size(), direct.poses.size());

@@ -155,6 +155,7 @@ class FairingWindow {
   // What the rotation rows apply to: the measured increments ζ, or with a gyro their residual.
   const SlidingArray<Vec3>& rotation_increments() const { return aided_ ? residual_ : zeta_; }
   void note_interval(double dt);
+  double rate_change(double step);
   double typical_interval() const;
   bool needs_rate() const;
   void prepare(double rate_hz);
@@ -194,10 +195,14 @@ class FairingWindow {
   Vec3 last_p_ = Vec3::Zero();
   bool last_has_position_ = false;
 
-  // The rate: given, or measured from the first intervals (stream_rate.hpp).
+  // The rate: given, or measured from the first intervals (stream_rate.hpp) and checked on
+  // in blocks of kMaxRateIntervals steps (rate_change).
   double rate_ = 0.0;
   bool prepared_ = false;  // W, the rows and the estimators are set for rate_
+  bool rate_measured_ = false;
   StreamRateEstimate rate_estimate_;
+  StreamRateEstimate rate_check_{kMaxRateIntervals};
+  double rate_candidate_ = 0.0;  // a block's rate that differed from rate_, awaiting the next
 
   // Linear solver.
   EmissionTarget target_spec_;

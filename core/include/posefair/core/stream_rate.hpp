@@ -17,6 +17,7 @@ namespace posefair {
 
 // The intervals that measure a live stream's rate, and the span a clumped one needs.
 inline constexpr int kRateIntervals = 8;
+inline constexpr int kMaxRateIntervals = 32;
 inline constexpr double kClumpedRateSpan = 1.0;  // seconds
 // Steps shorter than this (10 kHz) are the stamps of one read, not sampling intervals.
 inline constexpr double kShortestSampleInterval = 1e-4;  // seconds
@@ -32,9 +33,11 @@ double sample_rate(std::span<const double> time, double gap = 0.25);
 // The rate of a live stream, from its intervals as they come. Allocates nothing.
 class StreamRateEstimate {
  public:
+  // From the first `intervals` intervals (at most kMaxRateIntervals).
+  explicit StreamRateEstimate(int intervals = kRateIntervals);
   // One interval: a positive step between consecutive samples that is not a gap.
   void note(double dt);
-  // The rate (Hz): 0 until known, then fixed. The median of the first kRateIntervals
+  // The rate (Hz): 0 until known, then fixed. The median of the first `intervals`
   // intervals, or, when they are clumped, the mean once kClumpedRateSpan has passed.
   double rate() const { return rate_; }
   // The stream's interval: 1/rate once known; before, the median of the intervals so far (their
@@ -43,7 +46,8 @@ class StreamRateEstimate {
   double typical_interval() const;
 
  private:
-  std::array<double, kRateIntervals> first_{};
+  std::array<double, kMaxRateIntervals> first_{};
+  int intervals_;
   long count_ = 0;  // intervals noted
   double sum_ = 0.0;
   bool clumped_ = false;
