@@ -170,6 +170,7 @@ FairingWindow::FairingWindow(const WindowConfig& config)
   const auto w = static_cast<std::size_t>(capacity_);
   samples_.resize(w);
   sampled_step_.resize(w);
+  stamp_.resize(w);
   z_.resize(w);
   x_.resize(w);
   zeta_.resize(w);
@@ -433,7 +434,7 @@ std::size_t FairingWindow::memory_bytes() const {
   bytes += (zeta_.capacity() + residual_.capacity() + est_.capacity() + c_.capacity() + dzp_.capacity() + cp_.capacity()) * sizeof(Vec3);
   bytes += (zp_.capacity() + xp_.capacity() + yp_.capacity() + e_.capacity() + u_.capacity() + w_scratch_.capacity() +
             rhs_.capacity()) * sizeof(Vec3);
-  bytes += (diag_.capacity() + sampled_step_.capacity()) * sizeof(double) + window_clamped_.capacity();
+  bytes += (diag_.capacity() + sampled_step_.capacity() + stamp_.capacity()) * sizeof(double) + window_clamped_.capacity();
   auto row_bytes = [](const EmissionRow& r) { return (r.zeta.capacity() + r.c.capacity()) * sizeof(double); };
   bytes += levels_.capacity() * sizeof(EmissionRow);
   for (const EmissionRow& r : levels_) bytes += row_bytes(r);
@@ -473,7 +474,7 @@ FairedPose FairingWindow::emit(int index) {
   FairedPose out;
   out.stream_id = s.stream_id;
   out.sequence = s.sequence;
-  out.time = s.time + config_.horizon_s;  // a prediction is stamped with the time it is for
+  out.time = stamp_[k] + config_.horizon_s;  // a prediction is stamped with the time it is for
   out.orientation = q;
   out.position = positions_ ? p : Vec3::Zero();
   out.measured = s.orientation;
@@ -510,6 +511,7 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
     ++counters_.restarts;
   }
   if (new_rate > 0.0) prepare(new_rate);
+  sampled_offset_ += gate_.sampled_step() - step;  // exactly 0 while the stamps are the sampled times
   const double dt = verdict == GateVerdict::Accept ? step : 0.0;
   const bool had_last = have_time_;
   last_time_ = s.time;
@@ -546,6 +548,7 @@ void FairingWindow::slide(int count) {
   auto drop = [&](auto& v) { v.drop_front(static_cast<std::size_t>(count), static_cast<std::size_t>(n_)); };
   drop(samples_);
   drop(sampled_step_);
+  drop(stamp_);
   drop(z_);
   if (config_.solver == WindowSolver::Linear) {
     drop(zeta_);
@@ -587,6 +590,8 @@ void FairingWindow::append(const Sample& s) {
   if (n_ == w_) slide(1);
   const auto k = static_cast<std::size_t>(n_);
   samples_[k] = s;
+  samples_[k].time = s.time + sampled_offset_;
+  stamp_[k] = s.time;
   sampled_step_[k] = gate_.sampled_step();
   window_clamped_[k] = 0;
   Quat z = s.orientation;

@@ -55,7 +55,10 @@ GateVerdict SampleGate::check(Sample& s) {
   if (std::isfinite(last_time_)) {
     const double step = s.time - last_time_;
     gap = step > config_.gap_threshold || (interval_ > 0.0 && step - ahead_ > config_.gap_intervals * interval_);
-    sampled_step_ = gap || interval_ == 0.0 ? step : std::max(interval_, step - ahead_);
+    // Inside a clump (a step under half the interval) or catching up after one, a sample was
+    // taken an interval after the last, or what the step takes beyond the catching up.
+    const bool clumped = interval_ > 0.0 && (step < 0.5 * interval_ || ahead_ > 0.5 * interval_);
+    sampled_step_ = gap || !clumped ? step : std::max(interval_, step - ahead_);
     // A clump runs ahead of one sample per interval; the steps after it catch up. 5 % of the
     // time that passes is forgiven, so a burst of stale samples at start-up, or a rate measured
     // a little high, does not hide the gaps after it for long.

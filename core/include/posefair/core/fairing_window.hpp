@@ -218,8 +218,13 @@ class FairingWindow {
   MotionNoiseEstimator aided_estimator_;
 
   // Per sample, index 0 = oldest.
-  SlidingArray<Sample> samples_;   // as accepted (time, ids, measured values with their own sign)
+  // As accepted (ids, measured values with their own sign), but timed by when they were taken:
+  // their stamps, moved by the sum of what the gate's sampled steps differ from the stamped ones
+  // (sampled_offset_), so a clump's samples are an interval apart for the gyro aiding too.
+  SlidingArray<Sample> samples_;
+  SlidingArray<double> stamp_;         // each sample's own time, which its pose is stamped with
   SlidingArray<double> sampled_step_;  // the gate's sampled_step() of each
+  double sampled_offset_ = 0.0;
   SlidingArray<Quat> z_;           // measurement, hemisphere-continuous
   SlidingArray<Quat> x_;           // current estimate (iterative solvers)
   SlidingArray<Vec3> zeta_;        // ζ_j = log(z_j⁻¹ z_{j+1}) (Linear)

@@ -66,9 +66,9 @@ class SampleGate {
   // it, beyond what catches up with a clump, is a gap as well.
   void set_interval(double interval);
   // How long after the previous accepted sample the last one was taken, as far as the stamps
-  // tell: its stamped step less what that catches up with a clump, and at least the interval
-  // once that is known; after a gap, or while the interval is unknown, the stamped step; 0 for
-  // the first sample.
+  // tell: inside a clump (a step under half the interval) or after one, its stamped step less
+  // what that catches up, and at least the interval; otherwise (and after a gap, or while the
+  // interval is unknown) the stamped step; 0 for the first sample.
   double sampled_step() const { return sampled_step_; }
 
  private:
