@@ -48,7 +48,9 @@ if [[ -z "$faketime_lib" ]]; then
   exit 1
 fi
 asan=()
-if ldd "$build/daemon/posefaird" | grep -q libasan; then asan=(--asan); fi
+# Not `ldd | grep -q`: grep -q leaves at the first match, ldd may then die of SIGPIPE, and with
+# pipefail the test is false: the ASan daemon's RSS was judged like a plain one's (and failed).
+if [[ "$(ldd "$build/daemon/posefaird")" == *libasan* ]]; then asan=(--asan); fi
 
 echo "soak: $duration s, binaries from $build, work in $work (POSEFAIR_SOAK_KEEP=1 keeps it)"
 python3 "$here/soak.py" --duration "$duration" --posefaird "$build/daemon/posefaird" \
