@@ -1,6 +1,7 @@
 #include "posefair/core/smoothing_adaptation.hpp"
 
 #include "posefair/core/combinatorics.hpp"
+#include "posefair/core/upper_median.hpp"
 #include "posefair/core/weighted_vector_sum.hpp"
 
 #include <algorithm>
@@ -68,9 +69,7 @@ void MotionNoiseEstimator::update_noise(double length, double dt) {
     // Exact median of the first values: a sound start for the tracker below.
     first_lengths_[static_cast<std::size_t>(noise_count_++)] = length;
     std::array<double, 15> sorted = first_lengths_;
-    const auto n = static_cast<std::ptrdiff_t>(noise_count_);
-    std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.begin() + n);
-    log_median_ = std::log(sorted[static_cast<std::size_t>(n / 2)]);
+    log_median_ = std::log(upper_median(std::span(sorted).first(static_cast<std::size_t>(noise_count_))));
   } else {
     // Stochastic approximation of the median in log space: a step up when above, down when
     // below; its time constant is about 1/(2·step) samples.

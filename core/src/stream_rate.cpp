@@ -4,17 +4,9 @@
 #include <numeric>
 #include <vector>
 
+#include "posefair/core/upper_median.hpp"
+
 namespace posefair {
-namespace {
-
-// The upper median (index n/2) of values, reordered in place.
-double upper_median(std::span<double> values) {
-  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), mid, values.end());
-  return *mid;
-}
-
-}  // namespace
 
 bool intervals_are_clumped(std::span<const double> intervals) {
   if (intervals.empty()) return false;
