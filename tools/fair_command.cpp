@@ -113,10 +113,11 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
     };
     channel("rotation", st.rotation, "rad");
     if (in.has_position()) channel("position", st.position, "units");
-    std::printf("samples  %llu emitted, %llu clamped to the bound, %llu restarts after gaps, %llu dropped, %llu rejected\n",
+    std::printf("samples  %llu emitted, %llu clamped to the bound, %llu restarts after gaps or changes of rate (%llu for a "
+                "change of rate), %llu dropped, %llu rejected\n",
                 static_cast<unsigned long long>(r.counters.emitted), static_cast<unsigned long long>(r.counters.clamped),
-                static_cast<unsigned long long>(r.counters.restarts), static_cast<unsigned long long>(r.gate.dropped()),
-                static_cast<unsigned long long>(r.gate.rejected()));
+                static_cast<unsigned long long>(r.counters.restarts), static_cast<unsigned long long>(r.counters.rate_changes),
+                static_cast<unsigned long long>(r.gate.dropped()), static_cast<unsigned long long>(r.gate.rejected()));
     print_deviation_line(r.max_dist_r, in.has_position(), r.max_deviation_t);
     std::printf("cost     %.0f ns per sample\nwrote    %s\n", 1e9 * seconds / std::max<std::size_t>(1, in.size()), o.output.c_str());
   }

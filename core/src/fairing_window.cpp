@@ -510,7 +510,10 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
     count = emit_pending(out);
     ++counters_.restarts;
   }
-  if (new_rate > 0.0) prepare(new_rate);
+  if (new_rate > 0.0) {
+    ++counters_.rate_changes;
+    prepare(new_rate);
+  }
   sampled_offset_ += gate_.sampled_step() - step;  // exactly 0 while the stamps are the sampled times
   const double dt = verdict == GateVerdict::Accept ? step : 0.0;
   const bool had_last = have_time_;

@@ -128,6 +128,7 @@ std::string streams_member(const std::vector<StreamStats>& now, const std::vecto
                 .add("out_of_order", s.out_of_order)
                 .add("clamped", s.clamped)
                 .add("restarts", s.restarts)
+                .add("rate_changes", s.rate_changes)
                 .add("published", s.published)
                 .add("send_failures", s.send_failures)
                 .add("recorded", s.recorded)

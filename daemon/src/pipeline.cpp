@@ -514,6 +514,7 @@ bool Pipeline::stream_pass(Stream& s) {
   s.counters.emitted.store(w.emitted, std::memory_order_relaxed);
   s.counters.clamped.store(w.clamped, std::memory_order_relaxed);
   s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
+  s.counters.rate_changes.store(w.rate_changes, std::memory_order_relaxed);
   s.counters.gyro.bridged.store(w.gyro_bridged, std::memory_order_relaxed);
   store_engine_state(s.counters, s.window.state());
   if (s.gyro_pairing) {
@@ -692,6 +693,7 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.emitted = get(s.counters.emitted);
     st.clamped = get(s.counters.clamped);
     st.restarts = get(s.counters.restarts);
+    st.rate_changes = get(s.counters.rate_changes);
     st.gyro_bridged = get(s.counters.gyro.bridged);
     st.engine = load_engine_state(s.counters);
     st.publish_dropped = s.pose_ring.dropped();

@@ -115,6 +115,10 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
                   us(s.latency.percentile(50)), us(s.latency.percentile(90)), us(s.latency.percentile(99)),
                   us(s.latency.max));
     lines.emplace_back(buf);
+    if (s.rate_changes > 0) {  // restarts the stream caused by changing its rate, not by a gap
+      std::snprintf(buf, sizeof buf, ", rate changes %" PRIu64 " (of the restarts)", s.rate_changes);
+      lines.back() += buf;
+    }
     if (s.raw_unfused > 0) {  // a raw IMU source without a fusion stage: say why nothing is faired
       std::snprintf(buf, sizeof buf, ", raw-only %" PRIu64 " (not faired: no orientation, no fusion stage)", s.raw_unfused);
       lines.back() += buf;

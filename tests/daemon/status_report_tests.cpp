@@ -58,6 +58,20 @@ TEST(StatusReport, RawOnlySamplesShowWithTheirReason) {
       << status_line({s}, {}, 1.0);
 }
 
+// A window restarted for a change of the stream's rate is counted among the restarts and on
+// its own, in the counter line (only when there was one) and in the control reply.
+TEST(StatusReport, AChangeOfRateShowsAmongTheRestarts) {
+  StreamStats s = stream(1, "head", 2000);
+  s.restarts = 3;
+  EXPECT_EQ(counter_lines({s}, {}, 0.0)[0].find("rate changes"), std::string::npos);
+  s.rate_changes = 1;
+  const auto lines = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(lines[0].find(", restarts 3,"), std::string::npos) << lines[0];
+  EXPECT_NE(lines[0].find(", rate changes 1 (of the restarts)"), std::string::npos) << lines[0];
+  const std::string json = streams_member({s}, {}, 1.0);
+  EXPECT_NE(json.find("\"restarts\":3,\"rate_changes\":1,"), std::string::npos) << json;
+}
+
 // [stream.engine] gyro_stream: the gyro part names the source and its matches from the start,
 // before any interval was aided, and STATUS= says how many samples found no reading.
 TEST(StatusReport, AGyroFromAnotherStreamShowsItsSourceAndMatches) {

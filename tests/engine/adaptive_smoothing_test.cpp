@@ -194,6 +194,7 @@ TEST(RateIndependence, AStreamThatChangesItsRateIsFollowed) {
     const CausalResult a = fair_causal(changed.input, now);
     EXPECT_NEAR(a.state.rate_hz, after, 1e-6 * after);
     EXPECT_LE(a.counters.restarts, 1u + (after < before ? 2u * kMaxRateIntervals : 0u));
+    EXPECT_EQ(a.counters.rate_changes, 1u) << "one change of rate, counted as such";
     // From 4 s on (the change is followed within 64 steps, and the window has filled again).
     auto error_after = [](const Stream& s, const std::vector<Quat>& out, double horizon) {
       std::vector<char> use(out.size(), 0);
@@ -223,6 +224,7 @@ TEST(RateIndependence, JitteredTimesDoNotChangeAMeasuredRate) {
   for (std::size_t i = 1; i < s.input.size(); ++i) s.input.time[i] = std::max(s.input.time[i], s.input.time[i - 1] + 1e-6);
   const CausalResult r = fair_causal(s.input, WindowConfig{});
   EXPECT_EQ(r.counters.restarts, 0u);
+  EXPECT_EQ(r.counters.rate_changes, 0u);
   EXPECT_NEAR(r.state.rate_hz, 100.0, 10.0);
 }
 

@@ -96,7 +96,8 @@ double cutoff_for_smoothing(double mu, double rate_hz, int order);
 struct WindowCounters {
   std::uint64_t emitted = 0;
   std::uint64_t clamped = 0;    // emitted poses the ε projection had to move
-  std::uint64_t restarts = 0;   // windows restarted after a gap, or for samples with/without positions or gyro
+  std::uint64_t restarts = 0;   // windows restarted after a gap, a change of rate, or for samples with/without positions or gyro
+  std::uint64_t rate_changes = 0;  // of those, for a change of the measured rate (the window restarted at the new one)
   std::uint64_t gyro_bridged = 0;  // readings missing from a gyro-aided window, bridged without a restart
 };
 
