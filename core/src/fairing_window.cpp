@@ -117,6 +117,8 @@ void validate(const WindowConfig& c) {
   const AdaptationSettings& a = c.adaptation;
   for (double t : {a.noise_time_s, a.motion_time_s, a.motion_span_s})
     if (!(t > 0.0 && t <= kMaxAdaptationTime)) bad(S::Adaptation, "the adaptation's time constants must be in (0, 600] seconds");
+  if (!(a.rest_threshold >= 0.0 && a.rest_threshold <= kMaxRestThreshold))
+    bad(S::Adaptation, "the rest threshold must be in [0, 100]");
   if (!(a.motion_margin > 0.0 && a.motion_margin <= kMaxMotionMargin))
     bad(S::Adaptation, "the adaptation's motion margin must be in (0, 100]");
   if (!(c.continuity >= 0.0) || !std::isfinite(c.continuity)) bad(S::Continuity, "continuity must be finite and >= 0");
@@ -289,13 +291,13 @@ void FairingWindow::prepare(double rate_hz) {
       for (int l = 0; l + 1 < level_count_; ++l)
         level_shared_gain_[static_cast<std::size_t>(l)] =
             shared_noise_gain(levels_[static_cast<std::size_t>(l)], levels_[static_cast<std::size_t>(l + 1)], w_, k);
-      rot_.estimator.configure(rate_hz, config_.adaptation);
-      pos_.estimator.configure(rate_hz, config_.adaptation);
+      rot_.estimator.configure(rate_hz, config_.adaptation, w_);
+      pos_.estimator.configure(rate_hz, config_.adaptation, w_);
       AdaptationSettings aided = config_.adaptation;
       aided.motion_span_s = w_ / rate_hz;
       aided.motion_time_s = std::max(aided.motion_time_s, aided.motion_span_s);
       aided.motion_floor = false;
-      aided_estimator_.configure(rate_hz, aided);
+      aided_estimator_.configure(rate_hz, aided, w_);
     }
   }
   prepared_ = true;
@@ -400,6 +402,7 @@ EngineState FairingWindow::state() const {
     if (ch.adaptive) {
       const MotionNoiseEstimator& estimator = rotation && aided_ ? aided_estimator_ : ch.estimator;
       out.noise = unit * std::sqrt(3.0 * estimator.noise_variance());
+      out.at_rest = estimator.at_rest();
       out.motion = dt > 0.0 ? unit * std::sqrt(3.0 * estimator.motion_variance()) / std::pow(dt, config_.order) : 0.0;
     }
   }
@@ -439,9 +442,9 @@ std::size_t FairingWindow::memory_bytes() const {
   bytes += levels_.capacity() * sizeof(EmissionRow);
   for (const EmissionRow& r : levels_) bytes += row_bytes(r);
   bytes += row_bytes(fill_row_) + row_bytes(rot_.fixed) + row_bytes(pos_.fixed);
-  // The builder's band matrix and scratch, and the estimators' fit weights.
+  // The builder's band matrix and scratch, and the three estimators' fit and line weights.
   bytes += static_cast<std::size_t>(capacity_) * (static_cast<std::size_t>(config_.order + 1) + 5) * sizeof(double) +
-           static_cast<std::size_t>(capacity_ + 1) * sizeof(Vec3) + 3 * static_cast<std::size_t>(capacity_) * sizeof(double);
+           static_cast<std::size_t>(capacity_ + 1) * sizeof(Vec3) + 3 * 2 * static_cast<std::size_t>(capacity_) * sizeof(double);
   for (const auto* set : {&factors_r_, &factors_t_}) {
     bytes += set->capacity() * sizeof(BandedCholesky);
     for (const BandedCholesky& f : *set) bytes += static_cast<std::size_t>(f.size() * (f.bandwidth() + 1)) * sizeof(double);

@@ -19,9 +19,12 @@ constexpr double kChi3Median = 1.5381722;
 }  // namespace
 
 MotionNoiseEstimator::MotionNoiseEstimator(int capacity, int order)
-    : order_(order), capacity_(capacity), fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0) {}
+    : order_(order),
+      capacity_(capacity),
+      fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
+      line_(static_cast<std::size_t>(std::max(1, capacity)), 0.0) {}
 
-void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& settings) {
+void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& settings, int window) {
   settings_ = settings;
   const int m = order_;
   // The span is motion_span_s at the stream's rate, but never fewer than the m + 1 samples that
@@ -57,6 +60,18 @@ void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& s
     fit_noise_gain_ += w * w;
     cumulative += w;
     if (i < span_ - 1) fit_[static_cast<std::size_t>(i)] = -cumulative;
+  }
+  // The least-squares slope through the window: w_i = (i − c)/Σ(i − c)², on the differences
+  // as above. Its noise gain is 1/Σ(i − c)².
+  line_span_ = std::clamp(window, 2, std::max(2, capacity_));
+  const double cl = 0.5 * (line_span_ - 1);
+  double sxx = 0.0;
+  for (int i = 0; i < line_span_; ++i) sxx += (i - cl) * (i - cl);
+  line_noise_gain_ = 1.0 / sxx;
+  cumulative = 0.0;
+  for (int i = 0; i + 1 < line_span_; ++i) {
+    cumulative += (i - cl) / sxx;
+    line_[static_cast<std::size_t>(i)] = -cumulative;
   }
 }
 
@@ -108,6 +123,13 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
       const double sample = d.squaredNorm() / 3.0;
       const double alpha = motion_ready_ ? 1.0 - std::exp(-motion_pending_s_ / settings_.motion_time_s) : 1.0;
       mean_square_ += alpha * (sample - mean_square_);
+      if (settings_.motion_floor && settings_.rest_threshold > 0.0 && n1 >= line_span_ - 1) {  // the rest test's line, once the window is full
+        const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return line_[static_cast<std::size_t>(j)]; },
+                                           zeta.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
+        const double slope = v.squaredNorm() / 3.0;
+        line_mean_square_ = line_ready_ ? line_mean_square_ + alpha * (slope - line_mean_square_) : slope;
+        line_ready_ = true;
+      }
       motion_ready_ = true;
       motion_pending_s_ = 0.0;
       refreshed = true;
@@ -115,7 +137,13 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
   }
   if (motion_ready_) {
     const double fit_noise = noise_var_ * fit_noise_gain_;
-    motion_var_ = std::max(settings_.motion_floor ? fit_noise : 0.0, mean_square_ - fit_noise);
+    const double threshold = settings_.rest_threshold;
+    at_rest_ = settings_.motion_floor && threshold > 0.0 && line_ready_ &&
+               line_mean_square_ < threshold * noise_var_ * line_noise_gain_;
+    if (at_rest_)
+      motion_var_ = mean_square_ < threshold * fit_noise ? 0.0 : mean_square_ - fit_noise;
+    else
+      motion_var_ = std::max(settings_.motion_floor ? fit_noise : 0.0, mean_square_ - fit_noise);
   }
   return refreshed || ready() != was_ready;
 }

@@ -36,6 +36,7 @@ std::string channel(const ChannelAdaptation& c) {
       .number("motion", c.motion)
       .number("smoothing", c.smoothing)
       .number("cutoff_hz", c.cutoff_hz)
+      .add("at_rest", c.at_rest)
       .str();
 }
 

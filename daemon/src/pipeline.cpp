@@ -90,6 +90,7 @@ void store_engine_state(StreamCounters& c, const EngineState& e) {
     to.motion.store(from.motion, relaxed);
     to.smoothing.store(from.smoothing, relaxed);
     to.cutoff_hz.store(from.cutoff_hz, relaxed);
+    to.at_rest.store(from.at_rest, relaxed);
   }
   c.gyro.active.store(e.gyro.active, relaxed);
   c.gyro.offset_estimated.store(e.gyro.offset_estimated, relaxed);
@@ -113,6 +114,7 @@ EngineState load_engine_state(const StreamCounters& c) {
     to.motion = from.motion.load(relaxed);
     to.smoothing = from.smoothing.load(relaxed);
     to.cutoff_hz = from.cutoff_hz.load(relaxed);
+    to.at_rest = from.at_rest.load(relaxed);
   }
   e.gyro.active = c.gyro.active.load(relaxed);
   e.gyro.offset_estimated = c.gyro.offset_estimated.load(relaxed);

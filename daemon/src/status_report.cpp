@@ -67,8 +67,8 @@ std::string engine_text(const EngineState& e, const std::optional<GyroPairingSta
   text += buf;
   auto channel = [&](const char* name, const ChannelAdaptation& a, const char* unit) {
     if (a.adaptive)
-      std::snprintf(buf, sizeof buf, ", %s adapted: noise %.3g %s, motion %.3g %s/s^m, cutoff %.3g Hz (mu %.4g)", name, a.noise,
-                    unit, a.motion, unit, a.cutoff_hz, a.smoothing);
+      std::snprintf(buf, sizeof buf, ", %s adapted: noise %.3g %s, motion %.3g %s/s^m, cutoff %.3g Hz (mu %.4g)%s", name,
+                    a.noise, unit, a.motion, unit, a.cutoff_hz, a.smoothing, a.at_rest ? ", at rest" : "");
     else
       std::snprintf(buf, sizeof buf, ", %s fixed: cutoff %.3g Hz (mu %.4g)", name, a.cutoff_hz, a.smoothing);
     text += buf;
@@ -165,7 +165,8 @@ std::string status_line(const std::vector<StreamStats>& now, const std::vector<S
     out += buf;
     // What the smoothing is doing: its cutoff now (adapted or fixed), once the rate is known.
     if (s.engine.rate_hz > 0.0) {
-      std::snprintf(buf, sizeof buf, " fc %.3gHz%s", s.engine.rotation.cutoff_hz, s.engine.rotation.adaptive ? " (adapted)" : "");
+      const ChannelAdaptation& r = s.engine.rotation;
+      std::snprintf(buf, sizeof buf, " fc %.3gHz%s", r.cutoff_hz, !r.adaptive ? "" : r.at_rest ? " (adapted, at rest)" : " (adapted)");
       out += buf;
     }
     if (s.raw_unfused > 0) {

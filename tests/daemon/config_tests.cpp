@@ -92,6 +92,7 @@ rate_hz = 200
 noise_time = 4              # the adaptation's time constants (s) and margin
 motion_span = 0.5
 motion_margin = 3
+rest_threshold = 3          # 0: never at rest
 
 [[stream]]
 id = 7
@@ -222,6 +223,7 @@ TEST(Config, AFullConfigFillsEveryField) {
     EXPECT_EQ(e.adaptation.motion_time_s, 0.2);
     EXPECT_EQ(e.adaptation.motion_span_s, 0.5);
     EXPECT_EQ(e.adaptation.motion_margin, 1.5);
+    EXPECT_EQ(e.adaptation.rest_threshold, 3.0);
   }
   {
     const StreamConfig& s = c.streams[1];
@@ -1554,6 +1556,12 @@ name = "a"
 driver = { type = "synthetic", rate_hz = 100 }
 engine = { motion_margin = -1 }
 )", "stream[1].engine.motion_margin: out of range: must be in (0, 100], got -1", 5},
+    {"negative rest_threshold", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+engine = { rest_threshold = -0.5 }
+)", "stream[1].engine.rest_threshold: out of range: must be in [0, 100], got -0.5", 5},
     {"continuity with adapted smoothing", R"([engine]
 window = 32
 continuity = 1

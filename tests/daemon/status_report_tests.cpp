@@ -120,6 +120,14 @@ TEST(StatusReport, CounterLineAndStatusCarryTheEngineAdaptation) {
   s.engine.position = ChannelAdaptation{true, 2.5, 40.0, 12.0, 9.0};
   const auto fixed = counter_lines({s}, {}, 0.0);
   EXPECT_NE(fixed[0].find(", rotation fixed: cutoff 5 Hz (mu 100), position adapted: noise 2.5 units"), std::string::npos) << fixed[0];
+  // A still stream: the adaptation says it is at rest, in both texts and in the control reply.
+  s.engine.rotation = ChannelAdaptation{true, 0.0012, 0.0, 1e9, 0.11, true};
+  const auto still = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(still[0].find("rotation adapted: noise 0.0012 rad, motion 0 rad/s^m, cutoff 0.11 Hz (mu 1e+09), at rest"),
+            std::string::npos)
+      << still[0];
+  EXPECT_NE(status_line({s}, {}, 1.0).find(" fc 0.11Hz (adapted, at rest)"), std::string::npos) << status_line({s}, {}, 1.0);
+  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("cutoff_hz":0.11,"at_rest":true})"), std::string::npos) << streams_member({s}, {}, 1.0);
 }
 
 TEST(StatusReport, AFusionStageAddsItsBiasRestDisturbanceAndCounters) {

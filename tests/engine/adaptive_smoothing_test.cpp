@@ -1,5 +1,6 @@
 // The engine's defaults: rate independence, the adaptation's estimates and choices, the
 // emission rows' error model, and prediction (docs/engine.md, "Defaults and adaptation").
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -231,7 +232,7 @@ TEST(RateIndependence, JitteredTimesDoNotChangeAMeasuredRate) {
 TEST(Adaptation, TheMotionFitIsTakenEveryFourMillisecondsAtMost) {
   for (const double rate : {100.0, 1000.0}) {
     MotionNoiseEstimator estimator(128, 2);
-    estimator.configure(rate, AdaptationSettings{});
+    estimator.configure(rate, AdaptationSettings{}, 128);
     std::vector<Vec3> zeta;
     std::mt19937 random(7);
     std::normal_distribution<double> noise(0.0, 0.01);
@@ -324,6 +325,96 @@ TEST(Adaptation, AtTenHertzRealMotionIsNotTakenForNoise) {
   const double raw_rel = relative_error(input.orientation, truth, skip);
   const double out_rel = relative_error(r.poses.orientation, truth, skip);
   EXPECT_LT(out_rel, 1.01 * raw_rel) << "relative error " << out_rel << " against raw " << raw_rel;
+}
+
+// A stream still for 15 s (a tracker put down, a head held still), then turned 90° about z in
+// half a second, then still again: truth and measurements turned by noise of sigma per axis.
+Stream still_then_turn(double rate, double sigma, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  Stream s;
+  for (int i = 0; i < static_cast<int>(20.0 * rate); ++i) {
+    const double t = i / rate;
+    const double u = std::clamp((t - 15.0) / 0.5, 0.0, 1.0);
+    const Quat q = so3::from_rotation_vector(Vec3(0.0, 0.0, std::numbers::pi / 2.0 * u * u * (3.0 - 2.0 * u)));
+    s.input.time.push_back(t);
+    s.input.orientation.push_back(q * so3::from_rotation_vector(sigma * Vec3(noise(rng), noise(rng), noise(rng))));
+    s.truth.push_back(q);
+  }
+  return s;
+}
+
+double rms_error_between(const Stream& s, const std::vector<Quat>& out, double from, double to) {
+  std::vector<char> use(out.size(), 0);
+  for (std::size_t i = 0; i < out.size(); ++i) use[i] = s.input.time[i] >= from && s.input.time[i] < to;
+  return rotation_error(out, s.truth, use).rms;
+}
+
+TEST(Adaptation, AStillStreamIsSmoothedHardAndTheMotionAfterItIsNot) {
+  // The floor on the motion estimate held a still stream at a cutoff near 3.5 Hz at every rate
+  // (half the noise left). A line through the window that sees no slope either lets it go: a
+  // third less error at rest, and the turn costs no more than before.
+  for (const double rate : {30.0, 100.0, 250.0}) {
+    SCOPED_TRACE(std::to_string(rate) + " Hz");
+    const Stream s = still_then_turn(rate, 0.006, 5);
+    WindowConfig off;
+    off.adaptation.rest_threshold = 0.0;
+    const CausalResult on = fair_causal(s.input, WindowConfig{});
+    const CausalResult without = fair_causal(s.input, off);
+    // The state says so: at rest most of the still time (the slope's estimate is noisy too), and
+    // never while turning.
+    FairingWindow window{WindowConfig{}};
+    std::vector<FairedPose> out(static_cast<std::size_t>(window.max_outputs_per_push()));
+    int still_samples = 0, at_rest = 0, at_rest_turning = 0;
+    for (std::size_t i = 0; i < s.input.size(); ++i) {
+      Sample sample;
+      sample.time = s.input.time[i];
+      sample.orientation = s.input.orientation[i];
+      window.push(sample, out);
+      const bool rest = window.state().rotation.at_rest;
+      if (sample.time >= 2.0 && sample.time < 14.9) {
+        ++still_samples;
+        at_rest += rest ? 1 : 0;
+      }
+      if (sample.time >= 15.1 && sample.time < 15.6) at_rest_turning += rest ? 1 : 0;
+    }
+    EXPECT_GT(at_rest, 0.8 * still_samples);
+    EXPECT_EQ(at_rest_turning, 0);
+    EXPECT_FALSE(without.state.rotation.at_rest);
+    const double still = rms_error_between(s, on.poses.orientation, 2.0, 14.9);
+    const double still_before = rms_error_between(s, without.poses.orientation, 2.0, 14.9);
+    EXPECT_LT(still, 0.8 * still_before) << "at rest";
+    const double turn = rms_error_between(s, on.poses.orientation, 14.9, 16.0);
+    const double turn_before = rms_error_between(s, without.poses.orientation, 14.9, 16.0);
+    EXPECT_LT(turn, 1.05 * turn_before) << "the turn out of rest";
+  }
+}
+
+TEST(Adaptation, AVibrationIsNotTakenForRest) {
+  // A line through the window averages a vibration away; the fit of the motion does not, so a
+  // vibration above the noise is still followed: the same error as without the rest test, below
+  // raw.
+  for (const auto& [rate, hz] : {std::pair{100.0, 5.0}, std::pair{30.0, 3.0}}) {
+    SCOPED_TRACE(std::to_string(rate) + " Hz, vibration " + std::to_string(hz) + " Hz");
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> noise(0.0, 0.003);
+    Stream s;
+    for (int i = 0; i < static_cast<int>(20.0 * rate); ++i) {
+      const double t = i / rate;
+      const double w = 2.0 * std::numbers::pi * hz * t;
+      const Quat q = so3::from_rotation_vector(Vec3(0.01 * std::sin(w), 0.005 * std::sin(1.3 * w + 1.0), 0.0));
+      s.input.time.push_back(t);
+      s.input.orientation.push_back(q * so3::from_rotation_vector(Vec3(noise(rng), noise(rng), noise(rng))));
+      s.truth.push_back(q);
+    }
+    WindowConfig off;
+    off.adaptation.rest_threshold = 0.0;
+    const double raw = rms_error_between(s, s.input.orientation, 2.0, 20.0);
+    const double on = rms_error_between(s, fair_causal(s.input, WindowConfig{}).poses.orientation, 2.0, 20.0);
+    const double without = rms_error_between(s, fair_causal(s.input, off).poses.orientation, 2.0, 20.0);
+    EXPECT_LT(on, 1.01 * without);
+    EXPECT_LT(on, raw);
+  }
 }
 
 TEST(Adaptation, ANoiseFreeStreamPassesUnchanged) {

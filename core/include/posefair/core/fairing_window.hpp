@@ -109,6 +109,7 @@ struct ChannelAdaptation {
   double motion = 0.0;     // RMS m-th time derivative of the motion (rad/s^m, or units/s^m)
   double smoothing = 0.0;  // μ in use
   double cutoff_hz = 0.0;  // the cutoff μ corresponds to at the rate (0 while the rate is unknown)
+  bool at_rest = false;    // adapted: the stream is still, and smoothed as hard as the window allows (smoothing_adaptation.hpp)
 };
 struct EngineState {
   double rate_hz = 0.0;    // given or measured; 0 until known

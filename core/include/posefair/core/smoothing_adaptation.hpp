@@ -13,6 +13,11 @@
 //     fit lets through (σ² times the sum of its squared weights, known exactly). Motion
 //     below that noise cannot be told from none, so the estimate never goes below it: a
 //     stream that only seems still is not smoothed without limit.
+//   rest: a stream whose slope over the whole window is within its noise too is at rest (a
+//     tracker put down, a head held still). Then the floor is dropped, and the motion counts
+//     only where the fit sees it stand out of its noise: a still stream is smoothed as hard
+//     as the window allows, a vibration (which a line through the window averages away but the
+//     fit sees) is not.
 // The chosen μ minimises the expected squared error σ²G(μ) + d²B(μ)², the balance One Euro
 // strikes by hand with β: fast motion gets little smoothing (no lag, no clamping), slow motion
 // a lot. Every input is per sample; the time constants are in seconds, so streams of any rate
@@ -27,9 +32,10 @@
 namespace posefair {
 
 // Valid ranges (validate(WindowConfig), the daemon's keys): time constants in (0, 600] s,
-// the margin in (0, 100].
+// the margin in (0, 100], the rest threshold in [0, 100].
 inline constexpr double kMaxAdaptationTime = 600.0;
 inline constexpr double kMaxMotionMargin = 100.0;
+inline constexpr double kMaxRestThreshold = 100.0;
 
 struct AdaptationSettings {
   double noise_time_s = 2.0;   // how fast the noise estimate follows a change of noise
@@ -43,6 +49,12 @@ struct AdaptationSettings {
   // still is not smoothed without limit). Off for a gyro-aided residual, which is still by
   // construction: there the fit's noise would pass for motion and cap the smoothing.
   bool motion_floor = true;
+  // At rest when the mean square of the slope of a line through the whole window (averaged over
+  // motion_time_s, as the motion) is below this many times what the noise alone puts there; at
+  // rest the motion counts only above this many times the fit's noise, and the floor is dropped.
+  // Under noise alone both mean squares are once that noise. 0: never at rest (the floor always
+  // holds). Needs the floor: a gyro-aided residual has none to drop.
+  double rest_threshold = 2.0;
 };
 
 // Noise and motion of one channel (rotation or position), from its differences ζ.
@@ -51,8 +63,9 @@ class MotionNoiseEstimator {
   MotionNoiseEstimator(int capacity, int order);
 
   // Sets the fit's span for this rate (motion_span_s, at least order + 1 samples, at most
-  // capacity) and forgets nothing else.
-  void configure(double rate_hz, const AdaptationSettings& settings);
+  // capacity) and the rest test's line through `window` samples (the window's W, at most
+  // capacity), and forgets nothing else.
+  void configure(double rate_hz, const AdaptationSettings& settings, int window);
 
   // After a new sample: zeta holds the window's n−1 differences, newest last; dt is the
   // newest step (seconds). Differences across a window restart are never used. True when the
@@ -62,6 +75,7 @@ class MotionNoiseEstimator {
   static constexpr double kMotionRefreshes = 25.0;  // motion fits per motion_time_s, at most
 
   bool ready() const { return noise_count_ > 0 && motion_ready_; }
+  bool at_rest() const { return at_rest_; }
   double noise_variance() const { return noise_var_; }    // σ², per component, per sample
   double motion_variance() const { return motion_var_; }  // d², per component, per sample^(2m)
   int span() const { return span_; }
@@ -85,6 +99,14 @@ class MotionNoiseEstimator {
   bool motion_ready_ = false;
   double motion_pending_s_ = 0.0;  // stream time since the fit was last taken
   double motion_var_ = 0.0;
+  // Rest: the slope of a line through the newest line_span_ samples (weights on their
+  // differences, as fit_), its mean square, and Σ of its squared weights on θ.
+  int line_span_ = 0;
+  std::vector<double> line_;
+  double line_noise_gain_ = 0.0;
+  double line_mean_square_ = 0.0;
+  bool line_ready_ = false;
+  bool at_rest_ = false;
 };
 
 // The smoothing level (a real index into rows, ordered from least to most smoothing) with the
