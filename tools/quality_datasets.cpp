@@ -4,7 +4,9 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <limits>
+#include <numbers>
 #include <cstdint>
 #include <cstdio>
 #include <initializer_list>
@@ -48,6 +50,79 @@ QualitySequence synthetic(double rate, double noise, std::uint64_t seed, bool qu
   q.use.assign(q.input.size(), 1);
   for (std::size_t i = 0; i < q.use.size() && static_cast<double>(i) < 0.5 * rate; ++i) q.use[i] = 0;  // warm-up
   return q;
+}
+
+// A tracker that rests and turns (a head in VR, a tool put down and picked up), 20 s: still for
+// 1–3 s, then turned by 20–90° about a random axis in 0.3–0.8 s (smoothstep in the angle), and
+// so on, with synthetic()'s noise. The truth is analytic, evaluated 8 times as densely.
+QualitySequence rests_and_turns(double rate, double noise, std::uint64_t seed) {
+  constexpr int kDense = 8;
+  constexpr double kSeconds = 20.0;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  struct Turn {
+    double start, duration;
+    Vec3 rotation;  // axis × angle (rad)
+    Quat before;
+  };
+  std::vector<Turn> turns;
+  Quat q = Quat::Identity();
+  for (double t = 1.0 + 2.0 * uni(rng); t < kSeconds;) {
+    Vec3 axis(gauss(rng), gauss(rng), gauss(rng));
+    const double angle = (20.0 + 70.0 * uni(rng)) * std::numbers::pi / 180.0;
+    const Turn turn{t, 0.3 + 0.5 * uni(rng), axis.normalized() * angle, q};
+    turns.push_back(turn);
+    q = (turn.before * so3::from_rotation_vector(turn.rotation)).normalized();
+    t += turn.duration + 1.0 + 2.0 * uni(rng);
+  }
+  const auto truth_at = [&](double t) {
+    Quat at = Quat::Identity();
+    for (const Turn& turn : turns) {
+      if (t < turn.start) break;
+      const double u = std::min(1.0, (t - turn.start) / turn.duration);
+      at = (turn.before * so3::from_rotation_vector(u * u * (3.0 - 2.0 * u) * turn.rotation)).normalized();
+    }
+    return at;
+  };
+  QualitySequence s;
+  s.name = "seed" + std::to_string(seed);
+  s.rate_hz = rate;
+  const auto n = static_cast<std::size_t>(kSeconds * rate);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / rate;
+    s.input.time.push_back(t);
+    s.input.orientation.push_back((truth_at(t) * so3::exp(random_offset(rng, noise))).normalized());
+  }
+  std::vector<double> time;
+  std::vector<Quat> orientation;
+  for (std::size_t i = 0; i < kDense * (n - 1) + 1; ++i) {
+    time.push_back(static_cast<double>(i) / (kDense * rate));
+    orientation.push_back(truth_at(time.back()));
+  }
+  s.truth = TruthTrack(std::move(time), std::move(orientation), 1.5 / (kDense * rate));
+  s.use.assign(s.input.size(), 1);
+  for (std::size_t i = 0; i < s.use.size() && static_cast<double>(i) < 0.5 * rate; ++i) s.use[i] = 0;  // warm-up
+  return s;
+}
+
+// A synthetic data set: tuned on the training seeds' sequences, reported on the others'.
+QualityDataset seeded_set(const std::string& name, const std::vector<std::uint64_t>& train_seeds,
+                          const std::vector<std::uint64_t>& report_seeds, const std::function<QualitySequence(std::uint64_t)>& make) {
+  QualityDataset d;
+  d.name = name;
+  d.kind = "synthetic";
+  d.prediction = true;
+  QualityFold fold;
+  for (auto seeds : {&train_seeds, &report_seeds})
+    for (std::uint64_t seed : *seeds) {
+      (seeds == &train_seeds ? fold.train : fold.report).push_back(d.sequences.size());
+      d.sequences.push_back(make(seed));
+    }
+  d.split = "tuned on seeds " + std::to_string(train_seeds.front()) + "–" + std::to_string(train_seeds.back()) +
+            ", reported on seeds " + std::to_string(report_seeds.front()) + "–" + std::to_string(report_seeds.back());
+  d.folds.push_back(fold);
+  return d;
 }
 
 // The shift τ (s) by which a raw estimate trails its truth (estimate(t) ≈ truth(t − τ)), found on
@@ -272,24 +347,15 @@ std::vector<QualityDataset> load_quality_datasets(const std::filesystem::path& d
   const std::vector<double> noises = quick ? std::vector<double>{0.01} : std::vector<double>{0.01, 0.05};
   for (double rate : {100.0, 1000.0})
     for (double noise : noises) {
-      QualityDataset d;
       char name[64];
       std::snprintf(name, sizeof name, "synthetic-%gHz-noise%g", rate, noise);
-      d.name = name;
-      d.kind = "synthetic";
-      d.prediction = true;
-      QualityFold fold;
-      for (auto seeds : {&train_seeds, &report_seeds})
-        for (std::uint64_t seed : *seeds) {
-          (seeds == &train_seeds ? fold.train : fold.report).push_back(d.sequences.size());
-          d.sequences.push_back(synthetic(rate, noise, seed, quick));
-        }
-      d.split = "tuned on seeds " + std::to_string(train_seeds.front()) + "–" + std::to_string(train_seeds.back()) +
-                ", reported on seeds " + std::to_string(report_seeds.front()) + "–" + std::to_string(report_seeds.back());
-      d.folds.push_back(fold);
-      sets.push_back(std::move(d));
+      sets.push_back(seeded_set(name, train_seeds, report_seeds,
+                                [&](std::uint64_t seed) { return synthetic(rate, noise, seed, quick); }));
     }
   if (quick) return sets;
+  // Rests between turns: what a still tracker's noise becomes, and how the turns out of rest go.
+  sets.push_back(seeded_set("synthetic-100Hz-rests-noise0.01", train_seeds, report_seeds,
+                            [](std::uint64_t seed) { return rests_and_turns(100.0, 0.01, seed); }));
   // The recorded sets are read in full from dir. A sequence whose files are missing is skipped
   // with a line saying where it comes from; none of them there at all is an error.
   struct Broad {

@@ -5,9 +5,7 @@
 #include <random>
 
 namespace posefair {
-namespace {
 
-// A random direction and a magnitude uniform in [0, bound): the perturbations of Section 6.
 Vec3 random_offset(std::mt19937_64& rng, double bound) {
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::uniform_real_distribution<double> uni(0.0, 1.0);
@@ -15,8 +13,6 @@ Vec3 random_offset(std::mt19937_64& rng, double bound) {
   while (dir.norm() < 1e-12) dir = Vec3(gauss(rng), gauss(rng), gauss(rng));
   return dir.normalized() * (bound * uni(rng));
 }
-
-}  // namespace
 
 SyntheticMotion make_synthetic_motion(const SyntheticMotionSpec& spec) {
   std::mt19937_64 rng(spec.seed);

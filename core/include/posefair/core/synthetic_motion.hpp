@@ -4,6 +4,7 @@
 // papers' half-angle convention, so dist(noisy, truth) < bound), positions in a cube
 // perturbed by random offsets inside a ball. Deterministic for a given seed.
 #include <cstdint>
+#include <random>
 
 #include "posefair/core/pose_sequence.hpp"
 
@@ -26,5 +27,8 @@ struct SyntheticMotion {
 };
 
 SyntheticMotion make_synthetic_motion(const SyntheticMotionSpec& spec);
+
+// A random direction and a magnitude uniform in [0, bound): the perturbations of Section 6.
+Vec3 random_offset(std::mt19937_64& rng, double bound);
 
 }  // namespace posefair
