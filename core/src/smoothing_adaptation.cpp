@@ -100,6 +100,8 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
   const int k = order_ + 2;
   if (!(dt > 0.0)) return false;
   const bool was_ready = ready();
+  // The rest test's line is taken on a full window only: after a restart its average starts afresh.
+  if (n1 < line_span_ - 1) line_ready_ = false;
   bool refreshed = false;
   if (n1 >= k - 1 + 1) {
     // D^kθ at the newest = D^{k−1} of the newest k differences.
@@ -123,7 +125,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
       const double sample = d.squaredNorm() / 3.0;
       const double alpha = motion_ready_ ? 1.0 - std::exp(-motion_pending_s_ / settings_.motion_time_s) : 1.0;
       mean_square_ += alpha * (sample - mean_square_);
-      if (settings_.motion_floor && settings_.rest_threshold > 0.0 && n1 >= line_span_ - 1) {  // the rest test's line, once the window is full
+      if (settings_.motion_floor && settings_.rest_threshold > 0.0 && n1 >= line_span_ - 1) {
         const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return line_[static_cast<std::size_t>(j)]; },
                                            zeta.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
         const double slope = v.squaredNorm() / 3.0;
