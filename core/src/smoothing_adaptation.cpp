@@ -16,6 +16,21 @@ namespace {
 // normal components is below this half of the time.
 constexpr double kChi3Median = 1.5381722;
 
+// A sum Σ_i w_i θ_i over `span` samples whose weights sum to zero, as weights on the span's
+// differences: Σ w_i θ_i = −Σ_j W_j ζ_j with W_j = Σ_{i≤j} w_i, written to out[0, span − 1).
+// Returns Σ w_i², the sum's noise gain on θ.
+template <class Weight>
+double difference_weights(int span, Weight&& w, std::vector<double>& out) {
+  double cumulative = 0.0, gain = 0.0;
+  for (int i = 0; i < span; ++i) {
+    const double wi = w(i);
+    gain += wi * wi;
+    cumulative += wi;
+    if (i < span - 1) out[static_cast<std::size_t>(i)] = -cumulative;
+  }
+  return gain;
+}
+
 }  // namespace
 
 MotionNoiseEstimator::MotionNoiseEstimator(int capacity, int order)
@@ -50,29 +65,20 @@ void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& s
   unit(m) = 1.0;
   const Eigen::Vector4d a = ldlt.solve(unit);  // row m of (XᵀX)⁻¹
   const double m_factorial = factorial(m);
-  // Σ w_i θ_i = −Σ_j W_j ζ_j with W_j = Σ_{i≤j} w_i (the weights sum to zero).
-  double cumulative = 0.0;
-  fit_noise_gain_ = 0.0;
-  for (int i = 0; i < span_; ++i) {
-    double w = 0.0;
-    for (int p = 0; p < q; ++p) w += a(p) * std::pow(i - c, p);
-    w *= m_factorial;
-    fit_noise_gain_ += w * w;
-    cumulative += w;
-    if (i < span_ - 1) fit_[static_cast<std::size_t>(i)] = -cumulative;
-  }
-  // The least-squares slope through the window: w_i = (i − c)/Σ(i − c)², on the differences
-  // as above. Its noise gain is 1/Σ(i − c)².
+  fit_noise_gain_ = difference_weights(
+      span_,
+      [&](int i) {
+        double w = 0.0;
+        for (int p = 0; p < q; ++p) w += a(p) * std::pow(i - c, p);
+        return w * m_factorial;
+      },
+      fit_);
+  // The least-squares slope of a line through the window: w_i = (i − c)/Σ(i − c)².
   line_span_ = std::clamp(window, 2, std::max(2, capacity_));
   const double cl = 0.5 * (line_span_ - 1);
   double sxx = 0.0;
   for (int i = 0; i < line_span_; ++i) sxx += (i - cl) * (i - cl);
-  line_noise_gain_ = 1.0 / sxx;
-  cumulative = 0.0;
-  for (int i = 0; i + 1 < line_span_; ++i) {
-    cumulative += (i - cl) / sxx;
-    line_[static_cast<std::size_t>(i)] = -cumulative;
-  }
+  line_noise_gain_ = difference_weights(line_span_, [&](int i) { return (i - cl) / sxx; }, line_);
 }
 
 void MotionNoiseEstimator::update_noise(double length, double dt) {
