@@ -131,6 +131,14 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
       const double sample = d.squaredNorm() / 3.0;
       const double alpha = motion_ready_ ? 1.0 - std::exp(-motion_pending_s_ / settings_.motion_time_s) : 1.0;
       mean_square_ += alpha * (sample - mean_square_);
+      // A motion starting from rest: the average would take motion_time_s to see it, smoothing
+      // the start of the motion as hard as the rest. A fit that stands kRestOnsetFactor times
+      // over its noise twice running, and grows, is taken at once. (Noise alone puts one there
+      // once in 40 000 fits; a single outlier's weight in the fit shrinks as it moves inwards.)
+      const bool over = sample > kRestOnsetFactor * noise_var_ * fit_noise_gain_;
+      if (at_rest_ && over && onset_over_ && sample > onset_last_) mean_square_ = std::max(mean_square_, sample);
+      onset_over_ = over;
+      onset_last_ = sample;
       if (settings_.motion_floor && settings_.rest_threshold > 0.0 && n1 >= line_span_ - 1) {
         const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return line_[static_cast<std::size_t>(j)]; },
                                            zeta.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
@@ -146,8 +154,9 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
   if (motion_ready_) {
     const double fit_noise = noise_var_ * fit_noise_gain_;
     const double threshold = settings_.rest_threshold;
+    const double line_noise = noise_var_ * line_noise_gain_;
     at_rest_ = settings_.motion_floor && threshold > 0.0 && line_ready_ &&
-               line_mean_square_ < threshold * noise_var_ * line_noise_gain_;
+               line_mean_square_ < (at_rest_ ? kRestLeaveFactor : 1.0) * threshold * line_noise;
     if (at_rest_)
       motion_var_ = mean_square_ < threshold * fit_noise ? 0.0 : mean_square_ - fit_noise;
     else

@@ -17,7 +17,7 @@
 //     tracker put down, a head held still). Then the floor is dropped, and the motion counts
 //     only where the fit sees it stand out of its noise: a still stream is smoothed as hard
 //     as the window allows, a vibration (which a line through the window averages away but the
-//     fit sees) is not.
+//     fit sees) is not. A motion starting from rest is taken at once, not averaged in.
 // The chosen μ minimises the expected squared error σ²G(μ) + d²B(μ)², the balance One Euro
 // strikes by hand with β: fast motion gets little smoothing (no lag, no clamping), slow motion
 // a lot. Every input is per sample; the time constants are in seconds, so streams of any rate
@@ -51,7 +51,8 @@ struct AdaptationSettings {
   bool motion_floor = true;
   // At rest when the mean square of the slope of a line through the whole window (averaged over
   // motion_time_s, as the motion) is below this many times what the noise alone puts there; at
-  // rest the motion counts only above this many times the fit's noise, and the floor is dropped.
+  // rest the motion counts only above this many times the fit's noise, and the floor is dropped;
+  // it is at rest until twice this (MotionNoiseEstimator::kRestLeaveFactor).
   // Under noise alone both mean squares are once that noise. 0: never at rest (the floor always
   // holds). Needs the floor: a gyro-aided residual has none to drop.
   double rest_threshold = 2.0;
@@ -73,6 +74,15 @@ class MotionNoiseEstimator {
   // before stays as good until then: the noise estimate moves by a step of dt/noise_time_s).
   bool update(std::span<const Vec3> zeta, double dt);
   static constexpr double kMotionRefreshes = 25.0;  // motion fits per motion_time_s, at most
+  // A stream at rest stays at rest until the line's mean square is this many times the
+  // threshold. The window's slope is correlated over the whole window, so under noise alone a
+  // single threshold is crossed about once a second, and each crossing switches the smoothing
+  // between its heaviest level and a few Hz: a visible twitch in a still pose. A real motion
+  // puts the slope far above either.
+  static constexpr double kRestLeaveFactor = 2.0;
+  // At rest, a fit this many times over its noise, twice running and growing, is a motion
+  // starting: the motion estimate takes it at once instead of averaging it in.
+  static constexpr double kRestOnsetFactor = 8.0;
 
   bool ready() const { return noise_count_ > 0 && motion_ready_; }
   bool at_rest() const { return at_rest_; }
@@ -107,6 +117,8 @@ class MotionNoiseEstimator {
   double line_mean_square_ = 0.0;
   bool line_ready_ = false;
   bool at_rest_ = false;
+  bool onset_over_ = false;   // the last fit stood kRestOnsetFactor over its noise
+  double onset_last_ = 0.0;   // the last fit's mean square
 };
 
 // The smoothing level (a real index into rows, ordered from least to most smoothing) with the
