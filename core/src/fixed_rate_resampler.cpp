@@ -45,9 +45,19 @@ std::uint32_t FixedRateResampler::flags_between(double t) const {
   return after & (kBridged | kHasPosition);
 }
 
-std::size_t FixedRateResampler::push(const FairedPose& pose, std::span<FairedPose> out) {
+std::size_t FixedRateResampler::push(const FairedPose& stamped, std::span<FairedPose> out) {
+  if (have_stamp_ && !(stamped.time > last_stamp_)) return 0;
+  have_stamp_ = true;
+  last_stamp_ = stamped.time;
+  // Knots and grid on the times the samples were taken: a clump's stamps, 1 µs apart, would
+  // make the spline's velocities and the lerp's fractions meaningless.
+  FairedPose pose = stamped;
+  pose.time = clock_.next(stamped.time, stamped.step);
+  // Until the stream's rate is known a clump's sampled steps are its stamped ones, 1 µs: such
+  // a pose is no knot (the first of each clump is; the spline through those is smooth, late by
+  // up to a read, until the rate is known).
+  if (have_last_ && pose.time - last_time_ < kClumpStampStep) return 0;
   if (options_.interpolation == PoseInterpolation::MatrixLerp) return push_lerp(pose, out);
-  if (have_last_ && !(pose.time > last_time_)) return 0;
   const bool restart = have_last_ && pose.time - last_time_ > options_.max_step;
   if (restart) {
     spline_.clear();

@@ -1,5 +1,7 @@
 #include "posefair/core/gap_bridge.hpp"
 
+#include "posefair/core/sampled_clock.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -39,6 +41,22 @@ std::size_t GapBridge::push(const Sample& s, std::span<Sample> out) {
       out[n++] = held_;
       holding_ = false;
     }
+    out[n++] = s;
+    return n;
+  }
+  if (have_last_ && s.time - last_time_ < kClumpStampStep) {
+    // Read in a clump with the sample before (stamped µs apart): handed on as it is, but no
+    // knot (the spline's velocities would be per µs) and no interval (the pause after the clump
+    // would be a gap of thousands). A held sample goes first, its gap not bridged: its velocity
+    // needs a knot after it.
+    std::size_t n = 0;
+    if (holding_) {
+      out[n++] = held_;
+      holding_ = false;
+      before_ = held_;
+      ++counters_.clumped;
+    }
+    last_time_ = s.time;
     out[n++] = s;
     return n;
   }

@@ -86,7 +86,7 @@ Publisher::Result Publisher::publish(const RingPose& pose) {
   for (Output& out : outputs_) {
     if (!out.carries[pose.stream_index]) continue;
     result.carried = true;
-    if (!out.rate_limit.admit(pose.stream_index, pose.time)) continue;
+    if (!out.rate_limit.admit(pose.stream_index, pose.time, pose.step)) continue;
     const OutputEncoder& encoder = *encoders_[out.encoded];
     const std::uint64_t t0 = monotonic_ns();
     if (encoder.delivers()) {  // its own transport (DDS): no datagram, no destinations; counted as sending

@@ -82,6 +82,46 @@ TEST(GapBridge, AShortGapIsFilledOnTheSplineAtTheStreamsInterval) {
   EXPECT_EQ(bridge.push(sample_at(0.59, 59), out), 1u);
 }
 
+TEST(GapBridge, SamplesReadInClumpsPassThroughAndTheirGapsAreBridgedAtTheReadsPeriod) {
+  // 250 Hz read every 16 ms: four samples a read, stamped 1 µs apart. The pause after a read is
+  // no gap (by the last step, 1 µs, it was one of 16 000 missing samples, and 256 were made on
+  // a spline through knots 1 µs apart). Three reads are lost: matrix-lerp bridges them at the
+  // reads' period; the spline passes the gap through, since the sample after it is followed
+  // by its clump's next, 1 µs later, which cannot be its velocity's knot.
+  for (const PoseInterpolation interpolation : {PoseInterpolation::Spline, PoseInterpolation::MatrixLerp}) {
+    SCOPED_TRACE(interpolation == PoseInterpolation::Spline ? "spline" : "matrix-lerp");
+    GapBridgeOptions o;
+    o.interpolation = interpolation;
+    GapBridge bridge(o);
+    std::vector<Sample> out(bridge.max_outputs());
+    std::vector<Sample> all;
+    for (int i = 0; i < 400; ++i) {
+      const int read = i / 4;
+      if (read >= 50 && read < 53) continue;  // lost
+      Sample s = sample_at(0.016 * read + 1e-6 * (i % 4), static_cast<std::uint64_t>(i));
+      const std::size_t n = bridge.push(s, out);
+      all.insert(all.end(), out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n));
+    }
+    const std::size_t n = bridge.flush(out);
+    all.insert(all.end(), out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n));
+    std::size_t bridged = 0;
+    for (std::size_t k = 0; k < all.size(); ++k) {
+      if (k > 0) EXPECT_GT(all[k].time, all[k - 1].time) << "in order";
+      if (!(all[k].flags & kBridged)) continue;
+      ++bridged;
+      EXPECT_LT(so3::rotation_angle(all[k].orientation, truth_q(all[k].time)), 0.01) << "t = " << all[k].time;
+    }
+    EXPECT_EQ(all.size(), 388u + bridged) << "every sample handed on once";
+    if (interpolation == PoseInterpolation::MatrixLerp) {
+      EXPECT_EQ(bridged, 3u);
+      EXPECT_EQ(bridge.counters().gaps, 1u);
+    } else {
+      EXPECT_EQ(bridged, 0u);
+      EXPECT_EQ(bridge.counters().clumped, 1u);
+    }
+  }
+}
+
 TEST(GapBridge, AGapLongerThanMaxGapPassesThrough) {
   GapBridgeOptions o;
   o.max_gap = 0.05;
@@ -162,6 +202,49 @@ TEST(FixedRateResampler, A100HzStreamComesOutOnThe250HzGridCloseToTheTruth) {
   // The added delay: at most (lookahead + 1) input intervals.
   EXPECT_LE(worst_delay, static_cast<double>(r.delay_intervals()) * 0.01 + 1e-12);
   EXPECT_GT(worst_delay, 0.0);
+}
+
+TEST(FixedRateResampler, SamplesStampedInClumpsAreResampledAtTheTimesTheyWereTaken) {
+  // 250 Hz read every 16 ms: four samples a read, stamped 1 µs apart, the newest at the time it
+  // was taken. Their sampled steps (SampleGate) are the stamped ones until the rate is known
+  // (after 1 s), then one interval. Through knots 1 µs apart the spline's grid poses were off
+  // by up to 2 rad; placed at the times the samples were taken they are exact, and before the
+  // rate is known the first sample of each read is the knot, late by up to a read.
+  for (const PoseInterpolation interpolation : {PoseInterpolation::Spline, PoseInterpolation::MatrixLerp}) {
+    SCOPED_TRACE(interpolation == PoseInterpolation::Spline ? "spline" : "matrix-lerp");
+    FixedRateResamplerOptions o;
+    o.rate_hz = 90.0;
+    o.interpolation = interpolation;
+    FixedRateResampler r(o);
+    std::vector<FairedPose> out(r.max_outputs());
+    double worst_late = 0.0, worst_early = 0.0;
+    int late = 0, early = 0;
+    double previous_stamp = 0.0;
+    for (int i = 0; i < 1000; ++i) {
+      const double taken = 0.004 * i;
+      const double stamp = 0.016 * (i / 4) + 0.012 + 1e-6 * (i % 4 - 3);
+      FairedPose p = pose_at(taken);
+      p.time = stamp;
+      p.step = i == 0 ? 0.0 : taken < 1.0 ? stamp - previous_stamp : 0.004;
+      previous_stamp = stamp;
+      const std::size_t n = r.push(p, out);
+      for (std::size_t j = 0; j < n; ++j) {
+        const FairedPose& g = out[j];
+        const double e = so3::rotation_angle(g.orientation, truth_q(g.time));
+        if (g.time > 1.1) {
+          worst_late = std::max(worst_late, std::max(e, (g.position - truth_p(g.time)).norm()));
+          ++late;
+        } else {
+          worst_early = std::max(worst_early, e);
+          ++early;
+        }
+      }
+    }
+    EXPECT_GT(late, 230);
+    EXPECT_GT(early, 80);
+    EXPECT_LT(worst_late, interpolation == PoseInterpolation::Spline ? 1e-4 : 1e-3);
+    EXPECT_LT(worst_early, 0.05);  // 12 ms late at about 1.5 rad/s at most
+  }
 }
 
 TEST(FixedRateResampler, ALongStepRestartsWithoutGridPosesInTheGap) {

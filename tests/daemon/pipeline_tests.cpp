@@ -619,6 +619,61 @@ TEST(Pipeline, TheBodyRateOfSamplesStampedInClumpsIsOverTheirInterval) {
   EXPECT_GT(checked, 500u);
 }
 
+// The same receive times: resampled onto a 90 Hz grid, and limited to 100 poses a second. Both
+// place the poses at the times the samples were taken (sampled_clock.hpp), not at their stamps:
+// through knots 1 µs apart the spline's grid poses were radians off, and by the stamps the limit
+// passed only the first, stalest sample of each read, 67 a second.
+TEST(Pipeline, SamplesStampedInClumpsAreResampledAndRateLimitedAtTheTimesTheyWereTaken) {
+  ScratchDir dir;
+  const Vec3 omega(0.3, -0.4, 2.0);
+  std::vector<Sample> clumped;
+  for (int k = 0; k < 800; ++k) {
+    Sample s;
+    s.stream_id = 1;
+    s.sequence = static_cast<std::uint64_t>(k);
+    const double sampled = k / 200.0;
+    s.orientation = so3::exp(0.5 * sampled * omega);
+    const double read = std::ceil(sampled / 0.015 + 1e-9) * 0.015;  // the newest of a read 5 ms before it
+    s.time = !clumped.empty() && read <= clumped.back().time ? clumped.back().time + 1e-6 : read;
+    clumped.push_back(s);
+  }
+  write_imu_log(dir / "in.pflog", clumped);
+  const auto run = [&](const std::string& stream_keys, const std::string& output_keys) {
+    UdpCollector receiver;
+    const std::string text = "[[stream]]\nid = 1\nname = \"tracker\"\nring_capacity = 4096\n"
+                             "[stream.driver]\ntype = \"replay\"\npath = \"" +
+                             (dir / "in.pflog").string() + "\"\ntiming = \"fast\"\n" + stream_keys +
+                             "\n[[output]]\n" + output_keys + "destinations = [\"127.0.0.1:" +
+                             std::to_string(receiver.port()) + "\"]\n";
+    run_to_end(parse_config(text, "/virtual/clumped.toml"));
+    receiver.drain();
+    return receiver.messages();
+  };
+  {
+    SCOPED_TRACE("publish_rate_hz = 90");
+    const std::vector<PoseMessage> grid = run("[stream.spline]\npublish_rate_hz = 90\n", "");
+    std::size_t checked = 0;
+    for (const PoseMessage& m : grid) {
+      if (m.sample_time < 1.2) continue;  // the rate is measured over the first second
+      // The newest sample of a read is placed at its stamp, 5 ms after it was taken.
+      const Quat truth = so3::exp(0.5 * (m.sample_time - 0.005) * omega);
+      EXPECT_LT(so3::rotation_angle(m.orientation, truth), 1e-3) << "t = " << m.sample_time;
+      ++checked;
+    }
+    EXPECT_GT(checked, 240u);
+  }
+  {
+    SCOPED_TRACE("max_rate_hz = 100");
+    const std::vector<PoseMessage> limited = run("", "max_rate_hz = 100\n");
+    std::vector<std::uint64_t> late;
+    for (const PoseMessage& m : limited)
+      if (m.sample_time >= 1.2) late.push_back(m.sequence);
+    // 200 Hz taken, 100 Hz passed: every second sample, 2.8 s of them.
+    EXPECT_GT(late.size(), 270u);
+    for (std::size_t i = 1; i < late.size(); ++i) EXPECT_EQ(late[i] - late[i - 1], 2u) << "at " << late[i];
+  }
+}
+
 TEST(Pipeline, OrientationWithAGyroIsFairedWithTheGyroAndItsEstimatesAreReported) {
   ScratchDir dir;
   posefair::testing::GyroTrackerSpec spec;

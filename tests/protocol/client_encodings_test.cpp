@@ -325,12 +325,32 @@ TEST(VrchatEncoding, TrackersAreOneToEightOrHeadOnePerStream) {
 TEST(OutputRateLimit, PassesAtMostTheRatePerStream) {
   OutputRateLimit limit(100.0, 2);
   int passed = 0;
-  for (int i = 0; i < 1000; ++i) passed += limit.admit(0, i * 0.001);  // 1 kHz for 1 s
+  for (int i = 0; i < 1000; ++i) passed += limit.admit(0, i * 0.001, i > 0 ? 0.001 : 0.0);  // 1 kHz for 1 s
   EXPECT_EQ(passed, 100);
-  EXPECT_TRUE(limit.admit(1, 0.0005));  // the other stream has its own clock
-  EXPECT_TRUE(limit.admit(0, 0.0));     // time went back (a restarted replay): starts over
+  EXPECT_TRUE(limit.admit(1, 0.0005, 0.0));  // the other stream has its own clock
+  EXPECT_TRUE(limit.admit(0, 0.0, 0.001));   // time went back (a restarted replay): starts over
   OutputRateLimit none(0.0, 1);
-  for (int i = 0; i < 10; ++i) EXPECT_TRUE(none.admit(0, 1.0));
+  for (int i = 0; i < 10; ++i) EXPECT_TRUE(none.admit(0, 1.0, 0.0));
+}
+
+TEST(OutputRateLimit, SamplesStampedInClumpsPassAtTheRateTheyWereTakenAt) {
+  // 250 Hz read every 16 ms: four samples stamped 1 µs apart per read, each sampled step one
+  // interval (SampleGate). At most 100 Hz passes every third sample (12 ms of sample time
+  // apart), 83 a second, as for the same stream evenly stamped. By the stamps only the first
+  // of each read would pass, 62 a second, and always the stalest.
+  OutputRateLimit clumped(100.0, 1), even(100.0, 1);
+  std::vector<int> passed_clumped, passed_even;
+  for (int i = 0; i < 1000; ++i) {  // 4 s
+    const double stamp = 0.016 * (i / 4) + 1e-6 * (i % 4);
+    const double step = i > 0 ? 0.004 : 0.0;
+    if (clumped.admit(0, stamp, step)) passed_clumped.push_back(i);
+    if (even.admit(0, 0.004 * i, step)) passed_even.push_back(i);
+  }
+  EXPECT_EQ(passed_even.size(), 334u);
+  ASSERT_GE(passed_clumped.size(), 330u);
+  EXPECT_LE(passed_clumped.size(), 334u);
+  for (std::size_t k = 2; k < passed_clumped.size(); ++k)
+    EXPECT_EQ(passed_clumped[k] - passed_clumped[k - 1], 3) << "at sample " << passed_clumped[k];
 }
 
 }  // namespace

@@ -4,7 +4,9 @@
 // 90 Hz), interpolated with the C^k geometric spline through the faired poses.
 //
 // The grid is t = k / rate_hz on the stream's own clock, so streams at one rate share their
-// grid times. A grid pose is final once the spline around it is: the newest faired pose's time
+// grid times. The faired poses are placed at the times their samples were taken
+// (sampled_clock.hpp): for samples stamped in clumps, an interval apart up to the newest
+// one's stamp, not the stamps. A grid pose is final once the spline around it is: the newest faired pose's time
 // minus at most (lookahead + 1) input intervals, which is the delay resampling adds; the poses
 // carry their grid time, so a subscriber sees it as sent - t. A step longer than max_step
 // between faired poses (the window restarted after a gap) restarts the spline: no grid pose is
@@ -23,6 +25,7 @@
 #include "posefair/core/pose_spline_window.hpp"
 #include "posefair/core/rigid_pose_lerp.hpp"
 #include "posefair/core/sample.hpp"
+#include "posefair/core/sampled_clock.hpp"
 
 namespace posefair {
 
@@ -38,7 +41,7 @@ class FixedRateResampler {
   // Throws std::invalid_argument for bad options.
   explicit FixedRateResampler(const FixedRateResamplerOptions& options);
 
-  // Feeds one faired pose (a pose not after the previous one is ignored); writes the grid
+  // Feeds one faired pose (a pose stamped not after the previous one is ignored); writes the grid
   // poses now final to out (at least max_outputs() long) and returns how many. A grid pose is
   // kBridged when either faired pose around it is, and has a position when both have one.
   std::size_t push(const FairedPose& pose, std::span<FairedPose> out);
@@ -61,8 +64,11 @@ class FixedRateResampler {
   geometric_splines::PoseSplineWindow spline_;
   RigidPoseLerp lerp_;
   std::size_t max_outputs_;
+  SampledClock clock_;
+  bool have_stamp_ = false;
+  double last_stamp_ = 0.0;
   bool have_last_ = false;
-  double last_time_ = 0.0;
+  double last_time_ = 0.0;  // on the sampled clock
   std::int64_t next_ = 0;  // index of the next grid time
   FairedPose last_;
   double period_;

@@ -10,6 +10,11 @@
 //
 // With PoseInterpolation::MatrixLerp the gap is filled with Alexa's lerp of the two samples
 // around it (rigid_pose_lerp.hpp) as soon as the sample after it arrives: nothing is held.
+//
+// Samples read in a clump (stamped µs apart, kClumpStampStep) pass through: the first of each
+// clump is the knot and sets the interval, so the pause after a clump is no gap, and a gap is
+// bridged at the read's period. A gap whose first sample is followed by its clump's next is
+// passed through (counted: clumped), since that sample's spline velocity needs a later knot.
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -32,6 +37,7 @@ struct GapBridgeCounters {
   std::uint64_t gaps = 0;      // gaps bridged
   std::uint64_t samples = 0;   // samples made on the spline
   std::uint64_t too_long = 0;  // gaps longer than max_gap, passed through
+  std::uint64_t clumped = 0;   // gaps ended by samples read in a clump, passed through
   std::uint64_t lerp_fallbacks = 0;  // MatrixLerp: gaps lerp refused (a step of pi/2 or more), bridged separately
 };
 
