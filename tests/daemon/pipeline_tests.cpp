@@ -574,17 +574,9 @@ TEST(Pipeline, RawSamplesWithAFusionStageAreFusedFairedAndPublished) {
   }
 }
 
-// A tracker whose samples carry an orientation with 1° of jitter and a gyroscope reading with a
-// bias and a 5 ms time offset (20 s at 200 Hz, replayed from a sample log): the engine fairs it
-// with the gyro by default, and the bias and offset it estimates reach the stats, the counter
-// line and STATUS=. With `gyro_aided = false` the same stream is faired alone, and its error
-// against the true motion is at least twice as large.
-// Receive times of a 200 Hz tracker read every 15 ms: three samples per read, stamped 1 µs
-// apart. The published body rate is the rotation over the time the samples were taken apart
-// (one interval), not over their stamps' 1 µs, which made it 5000 times too fast.
-TEST(Pipeline, TheBodyRateOfSamplesStampedInClumpsIsOverTheirInterval) {
-  ScratchDir dir;
-  const Vec3 omega(0.3, -0.4, 2.0);  // rad/s, constant: the engine passes the motion unchanged
+// 200 Hz turning at the constant rate omega (rad/s), read every 15 ms: three samples a read,
+// stamped 1 µs apart, the newest of a read 5 ms after it was taken.
+std::vector<Sample> clumped_turning_stream(const Vec3& omega) {
   std::vector<Sample> clumped;
   for (int k = 0; k < 800; ++k) {
     Sample s;
@@ -596,6 +588,16 @@ TEST(Pipeline, TheBodyRateOfSamplesStampedInClumpsIsOverTheirInterval) {
     s.time = !clumped.empty() && read <= clumped.back().time ? clumped.back().time + 1e-6 : read;
     clumped.push_back(s);
   }
+  return clumped;
+}
+
+// Receive times of a 200 Hz tracker read every 15 ms: three samples per read, stamped 1 µs
+// apart. The published body rate is the rotation over the time the samples were taken apart
+// (one interval), not over their stamps' 1 µs, which made it 5000 times too fast.
+TEST(Pipeline, TheBodyRateOfSamplesStampedInClumpsIsOverTheirInterval) {
+  ScratchDir dir;
+  const Vec3 omega(0.3, -0.4, 2.0);  // rad/s, constant: the engine passes the motion unchanged
+  const std::vector<Sample> clumped = clumped_turning_stream(omega);
   write_imu_log(dir / "in.pflog", clumped);
   UdpCollector receiver;
   const std::string text = "[[stream]]\nid = 1\nname = \"tracker\"\nring_capacity = 4096\n"
@@ -626,18 +628,7 @@ TEST(Pipeline, TheBodyRateOfSamplesStampedInClumpsIsOverTheirInterval) {
 TEST(Pipeline, SamplesStampedInClumpsAreResampledAndRateLimitedAtTheTimesTheyWereTaken) {
   ScratchDir dir;
   const Vec3 omega(0.3, -0.4, 2.0);
-  std::vector<Sample> clumped;
-  for (int k = 0; k < 800; ++k) {
-    Sample s;
-    s.stream_id = 1;
-    s.sequence = static_cast<std::uint64_t>(k);
-    const double sampled = k / 200.0;
-    s.orientation = so3::exp(0.5 * sampled * omega);
-    const double read = std::ceil(sampled / 0.015 + 1e-9) * 0.015;  // the newest of a read 5 ms before it
-    s.time = !clumped.empty() && read <= clumped.back().time ? clumped.back().time + 1e-6 : read;
-    clumped.push_back(s);
-  }
-  write_imu_log(dir / "in.pflog", clumped);
+  write_imu_log(dir / "in.pflog", clumped_turning_stream(omega));
   const auto run = [&](const std::string& stream_keys, const std::string& output_keys) {
     UdpCollector receiver;
     const std::string text = "[[stream]]\nid = 1\nname = \"tracker\"\nring_capacity = 4096\n"
@@ -674,6 +665,11 @@ TEST(Pipeline, SamplesStampedInClumpsAreResampledAndRateLimitedAtTheTimesTheyWer
   }
 }
 
+// A tracker whose samples carry an orientation with 1° of jitter and a gyroscope reading with a
+// bias and a 5 ms time offset (20 s at 200 Hz, replayed from a sample log): the engine fairs it
+// with the gyro by default, and the bias and offset it estimates reach the stats, the counter
+// line and STATUS=. With `gyro_aided = false` the same stream is faired alone, and its error
+// against the true motion is at least twice as large.
 TEST(Pipeline, OrientationWithAGyroIsFairedWithTheGyroAndItsEstimatesAreReported) {
   ScratchDir dir;
   posefair::testing::GyroTrackerSpec spec;
