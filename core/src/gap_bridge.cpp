@@ -36,27 +36,25 @@ std::size_t GapBridge::push(const Sample& s, std::span<Sample> out) {
   if (!usable(s) || (have_last_ && !(s.time > last_time_))) {
     // Not for the spline (the window's gate rejects or drops it). While a sample is held,
     // hand it on first so the order stays; the gap is then not bridged.
-    std::size_t n = 0;
-    if (holding_) {
-      out[n++] = held_;
-      holding_ = false;
-    }
+    std::size_t n = hand_on_held(out);
     out[n++] = s;
     return n;
   }
   if (have_last_ && s.time - last_time_ < kClumpStampStep) {
-    // Read in a clump with the sample before (stamped µs apart): handed on as it is, but no
-    // knot (the spline's velocities would be per µs) and no interval (the pause after the clump
-    // would be a gap of thousands). A held sample goes first, its gap not bridged: its velocity
-    // needs a knot after it.
+    // Read in a clump with the sample before (stamped µs apart): no knot (the spline's
+    // velocities would be per µs) and no interval (the pause after the clump would be a gap of
+    // thousands). After a held sample it waits with it for the next read, whose first sample is
+    // the knot the held one's velocity needs; when too many wait, they go on unbridged.
+    last_time_ = s.time;
+    if (holding_ && clump_count_ < clump_.size()) {
+      clump_[clump_count_++] = s;
+      return 0;
+    }
     std::size_t n = 0;
     if (holding_) {
-      out[n++] = held_;
-      holding_ = false;
-      before_ = held_;
       ++counters_.clumped;
+      n = hand_on_held(out);
     }
-    last_time_ = s.time;
     out[n++] = s;
     return n;
   }
@@ -116,11 +114,10 @@ std::size_t GapBridge::release(const Sample& current, std::span<Sample> out) {
     ++counters_.gaps;
     counters_.samples += n;
   }
-  out[n++] = held_;
-  holding_ = false;
-  before_ = held_;
-  // The current sample may itself end a gap: treat it as new, after the held one.
-  const double dt = current.time - held_.time;
+  // The current sample may itself end a gap: treat it as new, after the held one (and the
+  // samples of its read).
+  const double dt = current.time - last_time_;
+  n += hand_on_held(out.subspan(n));
   last_time_ = current.time;
   if (dt > kGapFactor * interval_) {
     if (dt <= options_.max_gap) {
@@ -170,11 +167,19 @@ std::size_t GapBridge::lerp_across(const Sample& after, std::span<Sample> out) {
   return n;
 }
 
-std::size_t GapBridge::flush(std::span<Sample> out) {
+std::size_t GapBridge::flush(std::span<Sample> out) { return hand_on_held(out); }
+
+// The held sample and the samples of its read that waited with it, in order; it is then the
+// last knot before any later gap.
+std::size_t GapBridge::hand_on_held(std::span<Sample> out) {
   if (!holding_) return 0;
+  std::size_t n = 0;
+  out[n++] = held_;
+  for (std::size_t i = 0; i < clump_count_; ++i) out[n++] = clump_[i];
+  clump_count_ = 0;
   holding_ = false;
-  out[0] = held_;
-  return 1;
+  before_ = held_;
+  return n;
 }
 
 }  // namespace posefair

@@ -85,9 +85,9 @@ TEST(GapBridge, AShortGapIsFilledOnTheSplineAtTheStreamsInterval) {
 TEST(GapBridge, SamplesReadInClumpsPassThroughAndTheirGapsAreBridgedAtTheReadsPeriod) {
   // 250 Hz read every 16 ms: four samples a read, stamped 1 µs apart. The pause after a read is
   // no gap (by the last step, 1 µs, it was one of 16 000 missing samples, and 256 were made on
-  // a spline through knots 1 µs apart). Three reads are lost: matrix-lerp bridges them at the
-  // reads' period; the spline passes the gap through, since the sample after it is followed
-  // by its clump's next, 1 µs later, which cannot be its velocity's knot.
+  // a spline through knots 1 µs apart). Three reads are lost: both bridge them at the reads'
+  // period. The spline's knot after the gap needs the next read's first sample (its own read's
+  // next is 1 µs later), so that read waits for it.
   for (const PoseInterpolation interpolation : {PoseInterpolation::Spline, PoseInterpolation::MatrixLerp}) {
     SCOPED_TRACE(interpolation == PoseInterpolation::Spline ? "spline" : "matrix-lerp");
     GapBridgeOptions o;
@@ -112,14 +112,33 @@ TEST(GapBridge, SamplesReadInClumpsPassThroughAndTheirGapsAreBridgedAtTheReadsPe
       EXPECT_LT(so3::rotation_angle(all[k].orientation, truth_q(all[k].time)), 0.01) << "t = " << all[k].time;
     }
     EXPECT_EQ(all.size(), 388u + bridged) << "every sample handed on once";
-    if (interpolation == PoseInterpolation::MatrixLerp) {
-      EXPECT_EQ(bridged, 3u);
-      EXPECT_EQ(bridge.counters().gaps, 1u);
-    } else {
-      EXPECT_EQ(bridged, 0u);
-      EXPECT_EQ(bridge.counters().clumped, 1u);
-    }
+    EXPECT_EQ(bridged, 3u);
+    EXPECT_EQ(bridge.counters().gaps, 1u);
+    EXPECT_EQ(bridge.counters().clumped, 0u);
   }
+}
+
+TEST(GapBridge, AReadTooLongToWaitEndsItsGapUnbridged) {
+  // After a gap, a read of more samples than may wait with the held one for the next read: the
+  // gap goes through unbridged and counted, and nothing is lost or reordered.
+  GapBridge bridge(GapBridgeOptions{});
+  std::vector<Sample> out(bridge.max_outputs());
+  std::vector<Sample> all;
+  auto push = [&](const Sample& s) {
+    const std::size_t n = bridge.push(s, out);
+    all.insert(all.end(), out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n));
+  };
+  std::uint64_t seq = 0;
+  for (int i = 0; i < 20; ++i) push(sample_at(0.01 * i, seq++));
+  const std::size_t read = GapBridge::kClumpHeld + 8;
+  for (std::size_t k = 0; k < read; ++k) push(sample_at(0.25 + 1e-6 * static_cast<double>(k), seq++));
+  for (int i = 1; i < 5; ++i) push(sample_at(0.25 + 0.01 * i, seq++));
+  const std::size_t n = bridge.flush(out);
+  all.insert(all.end(), out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n));
+  ASSERT_EQ(all.size(), seq);
+  for (std::size_t k = 0; k < all.size(); ++k) EXPECT_EQ(all[k].sequence, k);
+  EXPECT_EQ(bridge.counters().clumped, 1u);
+  EXPECT_EQ(bridge.counters().gaps, 0u);
 }
 
 TEST(GapBridge, AGapLongerThanMaxGapPassesThrough) {

@@ -13,8 +13,11 @@
 //
 // Samples read in a clump (stamped µs apart, kClumpStampStep) pass through: the first of each
 // clump is the knot and sets the interval, so the pause after a clump is no gap, and a gap is
-// bridged at the read's period. A gap whose first sample is followed by its clump's next is
-// passed through (counted: clumped), since that sample's spline velocity needs a later knot.
+// bridged at the read's period. After a gap the rest of the first read waits with its first
+// sample for the next read (whose first sample is the knot the spline's velocity needs): a
+// read's period of delay, once; more than kClumpHeld samples in a read and the gap is passed
+// through (counted: clumped).
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -37,7 +40,7 @@ struct GapBridgeCounters {
   std::uint64_t gaps = 0;      // gaps bridged
   std::uint64_t samples = 0;   // samples made on the spline
   std::uint64_t too_long = 0;  // gaps longer than max_gap, passed through
-  std::uint64_t clumped = 0;   // gaps ended by samples read in a clump, passed through
+  std::uint64_t clumped = 0;   // gaps ended by a read of more than kClumpHeld samples, passed through
   std::uint64_t lerp_fallbacks = 0;  // MatrixLerp: gaps lerp refused (a step of pi/2 or more), bridged separately
 };
 
@@ -52,11 +55,13 @@ class GapBridge {
   std::size_t push(const Sample& s, std::span<Sample> out);
   // The stream ended: the held sample, if any (not bridged: its velocity is not final).
   std::size_t flush(std::span<Sample> out);
-  std::size_t max_outputs() const { return options_.max_bridged + 2; }
+  std::size_t max_outputs() const { return options_.max_bridged + 2 + kClumpHeld; }
+  static constexpr std::size_t kClumpHeld = 32;  // samples of a read that wait with a held one
   const GapBridgeCounters& counters() const { return counters_; }
 
  private:
   std::size_t release(const Sample& current, std::span<Sample> out);
+  std::size_t hand_on_held(std::span<Sample> out);
   std::size_t lerp_across(const Sample& after, std::span<Sample> out);
 
   GapBridgeOptions options_;
@@ -68,6 +73,8 @@ class GapBridge {
   bool have_last_ = false;
   bool holding_ = false;
   Sample held_;
+  std::array<Sample, kClumpHeld> clump_{};  // the held sample's read, after it
+  std::size_t clump_count_ = 0;
   Sample before_;               // the last sample before the gap
 };
 
