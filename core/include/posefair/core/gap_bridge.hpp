@@ -51,9 +51,11 @@ class GapBridge {
 
   // Feeds one sample; writes the samples to hand on, in order, to out (at least max_outputs()
   // long) and returns how many: usually the sample itself; none while the first sample after a
-  // gap waits for its successor; then the bridged samples, the held one and this one.
+  // gap (and its read's next ones) wait for its successor; then the bridged samples, the held
+  // ones and this one.
   std::size_t push(const Sample& s, std::span<Sample> out);
-  // The stream ended: the held sample, if any (not bridged: its velocity is not final).
+  // The stream ended: the held sample and the samples of its read waiting with it, if any (not
+  // bridged: its velocity is not final).
   std::size_t flush(std::span<Sample> out);
   std::size_t max_outputs() const { return options_.max_bridged + 2 + kClumpHeld; }
   static constexpr std::size_t kClumpHeld = 32;  // samples of a read that wait with a held one
