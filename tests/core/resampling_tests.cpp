@@ -106,7 +106,9 @@ TEST(GapBridge, SamplesReadInClumpsPassThroughAndTheirGapsAreBridgedAtTheReadsPe
     all.insert(all.end(), out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n));
     std::size_t bridged = 0;
     for (std::size_t k = 0; k < all.size(); ++k) {
-      if (k > 0) EXPECT_GT(all[k].time, all[k - 1].time) << "in order";
+      if (k > 0) {
+        EXPECT_GT(all[k].time, all[k - 1].time) << "in order";
+      }
       if (!(all[k].flags & kBridged)) continue;
       ++bridged;
       EXPECT_LT(so3::rotation_angle(all[k].orientation, truth_q(all[k].time)), 0.01) << "t = " << all[k].time;
