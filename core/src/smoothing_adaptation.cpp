@@ -31,12 +31,41 @@ double difference_weights(int span, Weight&& w, std::vector<double>& out) {
   return gain;
 }
 
+// The m-th derivative at the centre of a least-squares polynomial of degree m through `span`
+// samples, as weights on their differences (difference_weights): w_i = m!·[(XᵀX)⁻¹Xᵀ]_{m,i},
+// X_{iq} = (i − c)^q. At most 4×4 (m ≤ 3): fixed size, no heap. Returns the fit's noise gain.
+double derivative_fit_weights(int span, int m, std::vector<double>& out) {
+  const double c = 0.5 * (span - 1);
+  Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
+  const int q = m + 1;
+  for (int i = 0; i < span; ++i) {
+    Eigen::Vector4d x = Eigen::Vector4d::Zero();
+    for (int p = 0; p < q; ++p) x(p) = std::pow(i - c, p);
+    normal += x * x.transpose();
+  }
+  for (int p = q; p < 4; ++p) normal(p, p) = 1.0;  // unused powers (m = 2)
+  const Eigen::LDLT<Eigen::Matrix4d> ldlt(normal);
+  Eigen::Vector4d unit = Eigen::Vector4d::Zero();
+  unit(m) = 1.0;
+  const Eigen::Vector4d a = ldlt.solve(unit);  // row m of (XᵀX)⁻¹
+  const double m_factorial = factorial(m);
+  return difference_weights(
+      span,
+      [&](int i) {
+        double w = 0.0;
+        for (int p = 0; p < q; ++p) w += a(p) * std::pow(i - c, p);
+        return w * m_factorial;
+      },
+      out);
+}
+
 }  // namespace
 
 MotionNoiseEstimator::MotionNoiseEstimator(int capacity, int order)
     : order_(order),
       capacity_(capacity),
       fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
+      short_fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
       line_(static_cast<std::size_t>(std::max(1, capacity)), 0.0) {}
 
 void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& settings, int window) {
@@ -49,30 +78,11 @@ void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& s
   // the noise estimate then reads as noise (docs/engine.md, "Where it cannot help").
   span_ = std::clamp(static_cast<int>(std::lround(settings.motion_span_s * rate_hz)), m + 1, std::max(m + 1, capacity_));
   span_ = std::min(span_, capacity_);
-  // Least-squares polynomial of degree m through the span, its m-th derivative at the centre:
-  // w_i = m!·[(XᵀX)⁻¹Xᵀ]_{m,i}, X_{iq} = (i − c)^q. At most 4×4 (m ≤ 3): fixed size, no heap.
-  const double c = 0.5 * (span_ - 1);
-  Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
-  const int q = m + 1;
-  for (int i = 0; i < span_; ++i) {
-    Eigen::Vector4d x = Eigen::Vector4d::Zero();
-    for (int p = 0; p < q; ++p) x(p) = std::pow(i - c, p);
-    normal += x * x.transpose();
-  }
-  for (int p = q; p < 4; ++p) normal(p, p) = 1.0;  // unused powers (m = 2)
-  const Eigen::LDLT<Eigen::Matrix4d> ldlt(normal);
-  Eigen::Vector4d unit = Eigen::Vector4d::Zero();
-  unit(m) = 1.0;
-  const Eigen::Vector4d a = ldlt.solve(unit);  // row m of (XᵀX)⁻¹
-  const double m_factorial = factorial(m);
-  fit_noise_gain_ = difference_weights(
-      span_,
-      [&](int i) {
-        double w = 0.0;
-        for (int p = 0; p < q; ++p) w += a(p) * std::pow(i - c, p);
-        return w * m_factorial;
-      },
-      fit_);
+  fit_noise_gain_ = derivative_fit_weights(span_, m, fit_);
+  // The fast part: the same fit over half the span (none where that is under m + 1 samples:
+  // 10 Hz with the default span).
+  short_span_ = span_ / 2 >= m + 1 ? span_ / 2 : 0;
+  if (short_span_ > 0) short_fit_noise_gain_ = derivative_fit_weights(short_span_, m, short_fit_);
   // The least-squares slope of a line through the window: w_i = (i − c)/Σ(i − c)².
   line_span_ = std::clamp(window, 2, std::max(2, capacity_));
   const double cl = 0.5 * (line_span_ - 1);
@@ -131,6 +141,17 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
       const double sample = d.squaredNorm() / 3.0;
       const double alpha = motion_ready_ ? 1.0 - std::exp(-motion_pending_s_ / settings_.motion_time_s) : 1.0;
       mean_square_ += alpha * (sample - mean_square_);
+      if (short_span_ > 0) {
+        // The fast part's fit on the newest half span and on the half before it, the smaller of
+        // the two: an outlier sits in one of them, a shake in both.
+        auto half_fit = [&](int back) {
+          const Vec3 v = weighted_vector_sum(0, short_span_ - 1, [&](int j) { return short_fit_[static_cast<std::size_t>(j)]; },
+                                             zeta.subspan(static_cast<std::size_t>(n1 - back - (short_span_ - 1))));
+          return v.squaredNorm() / 3.0;
+        };
+        const double fast = std::min(half_fit(0), half_fit(short_span_));
+        short_mean_square_ += alpha * (fast - short_mean_square_);
+      }
       // A motion starting from rest: the average would take motion_time_s to see it, smoothing
       // the start of the motion as hard as the rest. A fit that stands kRestOnsetFactor times
       // over its noise twice running, and grows, is taken at once. (Noise alone puts one there
@@ -161,6 +182,10 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
       motion_var_ = mean_square_ < threshold * fit_noise ? 0.0 : mean_square_ - fit_noise;
     else
       motion_var_ = std::max(settings_.motion_floor ? fit_noise : 0.0, mean_square_ - fit_noise);
+    // The fast part counts where it stands clear of the noise its fit lets through.
+    const double short_noise = noise_var_ * short_fit_noise_gain_;
+    if (short_span_ > 0 && short_mean_square_ > kFastMotionFactor * short_noise)
+      motion_var_ = std::max(motion_var_, short_mean_square_ - short_noise);
   }
   return refreshed || ready() != was_ready;
 }

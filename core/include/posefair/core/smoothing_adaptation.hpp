@@ -12,7 +12,8 @@
 //     the centre of a short span), squared, averaged over a short time, minus the noise the
 //     fit lets through (σ² times the sum of its squared weights, known exactly). Motion
 //     below that noise cannot be told from none, so the estimate never goes below it: a
-//     stream that only seems still is not smoothed without limit.
+//     stream that only seems still is not smoothed without limit. A fit over half the span
+//     adds the motion's fast part (a shake) where it stands clear of its own noise.
 //   rest: a stream whose slope over the whole window is within its noise too is at rest (a
 //     tracker put down, a head held still). Then the floor is dropped, and the motion counts
 //     only where the fit sees it stand out of its noise: a still stream is smoothed as hard
@@ -83,6 +84,12 @@ class MotionNoiseEstimator {
   // At rest, a fit this many times over its noise, twice running and growing, is a motion
   // starting: the motion estimate takes it at once instead of averaging it in.
   static constexpr double kRestOnsetFactor = 8.0;
+  // The fit over motion_span_s averages away a fast motion (a 6–8 Hz shake, which a quadratic
+  // over 0.25 s cannot follow), and the stream was then smoothed below the shake: two to five
+  // times raw's error. The same fit over half the span, on the newest half and on the half before
+  // it, sees it; the smaller of the two (an outlier is in one half only, a shake in both),
+  // averaged as the motion, counts where it stands this many times over its noise.
+  static constexpr double kFastMotionFactor = 4.0;
 
   bool ready() const { return noise_count_ > 0 && motion_ready_; }
   bool at_rest() const { return at_rest_; }
@@ -99,6 +106,12 @@ class MotionNoiseEstimator {
   int span_ = 0;
   std::vector<double> fit_;      // weights on the span's span−1 differences
   double fit_noise_gain_ = 0.0;  // Σ of the fit's squared weights on θ
+  // The motion's fast part: the same fit over half the span (0: none), its mean square (of the
+  // smaller of two neighbouring half spans), and its noise gain.
+  int short_span_ = 0;
+  std::vector<double> short_fit_;
+  double short_fit_noise_gain_ = 0.0;
+  double short_mean_square_ = 0.0;
   // Noise: the median of ‖D^{m+2}θ‖, exact over the first values, then tracked.
   std::array<double, 15> first_lengths_{};
   int noise_count_ = 0;
