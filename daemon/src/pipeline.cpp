@@ -526,6 +526,7 @@ bool Pipeline::stream_pass(Stream& s) {
   if (s.bridge) {
     s.counters.bridged_gaps.store(s.bridge->counters().gaps, std::memory_order_relaxed);
     s.counters.bridged_samples.store(s.bridge->counters().samples, std::memory_order_relaxed);
+    s.counters.unbridged_gaps.store(s.bridge->counters().too_long + s.bridge->counters().clumped, std::memory_order_relaxed);
   }
   if (s.fusion) store_fusion_state(s.counters.fusion, s.fusion->state(), s.fusion->waiting());
   if (s.bridge || s.resampler)
@@ -712,6 +713,7 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.resampling = s.config.spline.resampling();
     st.bridged_gaps = get(s.counters.bridged_gaps);
     st.bridged_samples = get(s.counters.bridged_samples);
+    st.unbridged_gaps = get(s.counters.unbridged_gaps);
     st.resampled = get(s.counters.resampled);
     st.matrix_lerp = s.config.spline.pose_interpolation == PoseInterpolation::MatrixLerp;
     st.lerp_fallbacks = get(s.counters.lerp_fallbacks);

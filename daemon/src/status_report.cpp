@@ -124,7 +124,8 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
       lines.back() += buf;
     }
     if (s.bridging) {
-      std::snprintf(buf, sizeof buf, ", bridged gaps %" PRIu64 " (samples %" PRIu64 ")", s.bridged_gaps, s.bridged_samples);
+      std::snprintf(buf, sizeof buf, ", bridged gaps %" PRIu64 " (samples %" PRIu64 ", passed through %" PRIu64 ")", s.bridged_gaps,
+                    s.bridged_samples, s.unbridged_gaps);
       lines.back() += buf;
     }
     if (s.resampling) {

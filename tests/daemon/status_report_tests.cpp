@@ -74,6 +74,17 @@ TEST(StatusReport, AChangeOfRateShowsAmongTheRestarts) {
 
 // [stream.engine] gyro_stream: the gyro part names the source and its matches from the start,
 // before any interval was aided, and STATUS= says how many samples found no reading.
+TEST(StatusReport, GapsBridgedAndPassedThroughShowWhenBridging) {
+  StreamStats s = stream(1, "head", 2000);
+  s.bridged_gaps = 2;
+  s.bridged_samples = 30;
+  s.unbridged_gaps = 1;
+  EXPECT_EQ(counter_lines({s}, {}, 0.0)[0].find("bridged gaps"), std::string::npos) << "not configured, not shown";
+  s.bridging = true;
+  const auto lines = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(lines[0].find(", bridged gaps 2 (samples 30, passed through 1)"), std::string::npos) << lines[0];
+}
+
 TEST(StatusReport, AGyroFromAnotherStreamShowsItsSourceAndMatches) {
   StreamStats s = stream(1, "optical", 100);
   s.gyro_pairing = GyroPairingStats{"imu", 0, 100};

@@ -28,6 +28,7 @@ struct StreamCounters {
   std::atomic<std::uint64_t> rate_changes{0};     // of which for a change of the measured rate
   std::atomic<std::uint64_t> bridged_gaps{0};     // input gaps filled on the spline ([stream.spline] bridge_gap)
   std::atomic<std::uint64_t> bridged_samples{0};  // samples made for them
+  std::atomic<std::uint64_t> unbridged_gaps{0};   // gaps passed through: longer than max_gap, or ended by a read too long to wait
   std::atomic<std::uint64_t> resampled{0};        // grid poses made ([stream.spline] publish_rate_hz)
   std::atomic<std::uint64_t> lerp_fallbacks{0};   // intervals matrix-lerp refused (pi/2 or more), interpolated separately
   std::atomic<std::uint64_t> published{0};        // poses sent to at least one destination (or to none configured)
@@ -90,7 +91,7 @@ struct StreamStats {
   HistogramSnapshot latency;
   EngineState engine;      // rate, window, the adaptation's noise, motion and cutoff, and the gyro aiding's estimates
   bool bridging = false, resampling = false;  // [stream.spline] parts configured
-  std::uint64_t bridged_gaps = 0, bridged_samples = 0, resampled = 0;
+  std::uint64_t bridged_gaps = 0, bridged_samples = 0, unbridged_gaps = 0, resampled = 0;
   bool matrix_lerp = false;  // [stream.spline] pose_interpolation = "matrix-lerp"
   std::uint64_t lerp_fallbacks = 0;
   std::optional<drivers::DeviceHealth> device;  // the device link, for drivers that have one
