@@ -152,12 +152,17 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
         const double fast = std::min(half_fit(0), half_fit(short_span_));
         short_mean_square_ += alpha * (fast - short_mean_square_);
       }
-      // A motion starting from rest: the average would take motion_time_s to see it, smoothing
-      // the start of the motion as hard as the rest. A fit that stands kRestOnsetFactor times
-      // over its noise twice running, and grows, is taken at once. (Noise alone puts one there
-      // once in 40 000 fits; a single outlier's weight in the fit shrinks as it moves inwards.)
-      const bool over = sample > kRestOnsetFactor * noise_var_ * fit_noise_gain_;
-      if (at_rest_ && over && onset_over_ && sample > onset_last_) mean_square_ = std::max(mean_square_, sample);
+      // A motion starting: the average would take motion_time_s to see it, smoothing the start
+      // of the motion as hard as what came before. A fit that stands over the onset threshold
+      // twice running, and grows, is taken at once: at rest kRestOnsetFactor times its noise
+      // (noise alone puts one there once in 40 000 fits), moving an excess over that noise
+      // kMotionOnsetFactor times the motion's (or the noise's, if larger). A single outlier's
+      // weight in the fit shrinks as it moves inwards, so it does not grow twice running.
+      const double fit_noise = noise_var_ * fit_noise_gain_;
+      const double onset = at_rest_ ? kRestOnsetFactor * fit_noise
+                                    : fit_noise + kMotionOnsetFactor * std::max(mean_square_ - fit_noise, fit_noise);
+      const bool over = sample > onset;
+      if (over && onset_over_ && sample > onset_last_) mean_square_ = std::max(mean_square_, sample);
       onset_over_ = over;
       onset_last_ = sample;
       if (settings_.motion_floor && settings_.rest_threshold > 0.0 && n1 >= line_span_ - 1) {
