@@ -156,8 +156,9 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
       // of the motion as hard as what came before. A fit that stands over the onset threshold
       // twice running, and grows, is taken at once: at rest kRestOnsetFactor times its noise
       // (noise alone puts one there once in 40 000 fits), moving an excess over that noise
-      // kMotionOnsetFactor times the motion's (or the noise's, if larger). A single outlier's
-      // weight in the fit shrinks as it moves inwards, so it does not grow twice running.
+      // kMotionOnsetFactor times the motion's (or the noise's, if larger). A single outlier's fit
+      // is largest as it enters the span and shrinks after; where it grows again (towards the
+      // span's centre) it stands at most a quarter as high.
       const double fit_noise = noise_var_ * fit_noise_gain_;
       const double onset = at_rest_ ? kRestOnsetFactor * fit_noise
                                     : fit_noise + kMotionOnsetFactor * std::max(mean_square_ - fit_noise, fit_noise);
