@@ -128,6 +128,9 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
     }
     update_noise(d.norm(), dt);
   }
+  // The noise each fit lets through, at the noise estimate just updated.
+  const double fit_noise = noise_var_ * fit_noise_gain_;
+  const double short_noise = noise_var_ * short_fit_noise_gain_;
   // The fit is taken at most kMotionRefreshes times per motion_time_s (every 4 ms by default):
   // the estimate averages over motion_time_s anyway, and fits a few samples apart share nearly
   // all their samples, so at 1 kHz three fits in four would add nothing but their cost (a
@@ -159,7 +162,6 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
       // kMotionOnsetFactor times the motion's (or the noise's, if larger). A single outlier's fit
       // is largest as it enters the span and shrinks after; where it grows again (towards the
       // span's centre) it stands at most a quarter as high.
-      const double fit_noise = noise_var_ * fit_noise_gain_;
       const double onset = at_rest_ ? kRestOnsetFactor * fit_noise
                                     : fit_noise + kMotionOnsetFactor * std::max(mean_square_ - fit_noise, fit_noise);
       const bool over = sample > onset;
@@ -179,7 +181,6 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
     }
   }
   if (motion_ready_) {
-    const double fit_noise = noise_var_ * fit_noise_gain_;
     const double threshold = settings_.rest_threshold;
     const double line_noise = noise_var_ * line_noise_gain_;
     at_rest_ = settings_.motion_floor && threshold > 0.0 && line_ready_ &&
@@ -189,7 +190,6 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
     else
       motion_var_ = std::max(settings_.motion_floor ? fit_noise : 0.0, mean_square_ - fit_noise);
     // The fast part counts where it stands clear of the noise its fit lets through.
-    const double short_noise = noise_var_ * short_fit_noise_gain_;
     if (short_span_ > 0 && short_mean_square_ > kFastMotionFactor * short_noise)
       motion_var_ = std::max(motion_var_, short_mean_square_ - short_noise);
   }
