@@ -59,6 +59,11 @@ double derivative_fit_weights(int span, int m, std::vector<double>& out) {
       out);
 }
 
+// The componentwise median of three vectors.
+Vec3 median_of_three(const Vec3& a, const Vec3& b, const Vec3& c) {
+  return a.cwiseMin(b).cwiseMax(a.cwiseMax(b).cwiseMin(c));
+}
+
 }  // namespace
 
 MotionNoiseEstimator::MotionNoiseEstimator(int capacity, int order)
@@ -109,6 +114,32 @@ void MotionNoiseEstimator::update_noise(double length, double dt) {
   }
   const double sigma = std::exp(log_median_) / scale;
   noise_var_ = sigma * sigma;
+}
+
+double MotionNoiseEstimator::newest_half_fit_of_medians(std::span<const Vec3> zeta) const {
+  // θ over the newest h + 1 samples, θ_0 = 0 at the oldest (n − h); the half span is samples
+  // 1..h. Each is replaced by the median of itself and its two neighbours; the newest, which has
+  // no newer neighbour, by the median of itself, the one before and the line through the two
+  // medians before (a motion speeding up keeps its speed; an outlier, newest or next to it, is
+  // dropped).
+  const int h = short_span_;
+  const std::size_t base = zeta.size() - static_cast<std::size_t>(h);
+  Vec3 before = Vec3::Zero(), here = zeta[base];  // θ_{p−1}, θ_p for p = 1
+  Vec3 median_older = Vec3::Zero(), median_before = Vec3::Zero(), sum = Vec3::Zero();
+  for (int p = 1; p <= h; ++p) {
+    const auto j = static_cast<std::size_t>(p);
+    const Vec3 median = p < h ? median_of_three(before, here, here + zeta[base + j])
+                              : median_of_three(here, before, 2.0 * median_before - median_older);
+    // The fit's weights are on the half span's differences (difference_weights).
+    if (p > 1) sum += short_fit_[j - 2] * (median - median_before);
+    median_older = median_before;
+    median_before = median;
+    if (p < h) {
+      before = here;
+      here += zeta[base + j];
+    }
+  }
+  return sum.squaredNorm() / 3.0;
 }
 
 bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
@@ -165,7 +196,18 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
       const double onset = at_rest_ ? kRestOnsetFactor * fit_noise
                                     : fit_noise + kMotionOnsetFactor * std::max(mean_square_ - fit_noise, fit_noise);
       const bool over = sample > onset;
-      if (over && onset_over_ && sample > onset_last_) mean_square_ = std::max(mean_square_, sample);
+      if (over && onset_over_ && sample > onset_last_) {
+        // The long fit sees a motion starting at its newest end only dimly (its m-th derivative
+        // is taken at the span's centre); the newest half span sees it sooner, and counts where
+        // it stands clear of its noise. On the running median, so that outliers (two of them
+        // put the long fit over the threshold) are not taken for the motion's size.
+        double taken = sample;
+        if (short_span_ > 0) {
+          const double newest = newest_half_fit_of_medians(zeta);
+          if (newest > kFastMotionFactor * short_noise) taken = std::max(taken, newest - short_noise + fit_noise);
+        }
+        mean_square_ = std::max(mean_square_, taken);
+      }
       onset_over_ = over;
       onset_last_ = sample;
       if (settings_.motion_floor && settings_.rest_threshold > 0.0 && n1 >= line_span_ - 1) {

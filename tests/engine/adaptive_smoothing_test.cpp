@@ -362,7 +362,11 @@ double rms_error_between(const Stream& s, const std::vector<Quat>& out, double f
 TEST(Adaptation, AStillStreamIsSmoothedHardAndTheMotionAfterItIsNot) {
   // The floor on the motion estimate held a still stream at a cutoff near 3.5 Hz at every rate
   // (half the noise left). A line through the window that sees no slope either lets it go: a
-  // third less error at rest, and the turn costs no more than before.
+  // third less error at rest, and the turn out of rest costs little more than with the rest
+  // test off. (That engine takes the turn's start a fit or two sooner, at about 5 times the
+  // noise instead of 8, and since the onset's size comes from the newest half span a fit sooner counts
+  // for more: 11% and 5% more at 100 and 250 Hz, 2% less at 30 Hz; 22% and 21% more without
+  // taking a motion starting at rest at once.)
   for (const double rate : {30.0, 100.0, 250.0}) {
     SCOPED_TRACE(std::to_string(rate) + " Hz");
     const Stream s = still_then_turn(rate, 0.006, 5);
@@ -402,16 +406,18 @@ TEST(Adaptation, AStillStreamIsSmoothedHardAndTheMotionAfterItIsNot) {
     EXPECT_LT(still, 0.8 * still_before) << "at rest";
     const double turn = rms_error_between(s, on.poses.orientation, 14.9, 16.0);
     const double turn_before = rms_error_between(s, without.poses.orientation, 14.9, 16.0);
-    EXPECT_LT(turn, 1.05 * turn_before) << "the turn out of rest";
+    EXPECT_LT(turn, 1.15 * turn_before) << "the turn out of rest";
   }
 }
 
 TEST(Adaptation, AMotionStartingFromRestIsTakenAtOnce) {
   // At rest the motion's average starts from nothing and would take its 0.1 s to see a turn,
   // smoothing the turn's start as hard as the rest. A fit far over its noise, twice running and
-  // growing, is taken at once: the turn out of rest is followed within 5% of the engine with
-  // the rest test off (which takes a quicker motion at once too, kMotionOnsetFactor; summed over
-  // seeds: +4% and +2% at 100 and 250 Hz; without the rule at rest +7.5% and +8.9%).
+  // growing, is taken at once: the turn out of rest is followed within 8% of the engine with
+  // the rest test off (which takes a quicker motion at once too, kMotionOnsetFactor, and a fit
+  // or two sooner; summed over seeds: +5.8% and +3.3% at 100 and 250 Hz; without the rule at rest
+  // +12% and +15%. Before the onset's size came from the newest half span: +4% and +2%, and
+  // +7.5% and +8.9%: both engines follow the turn sooner now, the one without rest most).
   for (const double rate : {100.0, 250.0}) {
     SCOPED_TRACE(std::to_string(rate) + " Hz");
     WindowConfig off;
@@ -422,7 +428,7 @@ TEST(Adaptation, AMotionStartingFromRestIsTakenAtOnce) {
       turn += rms_error_between(s, fair_causal(s.input, WindowConfig{}).poses.orientation, 14.9, 16.0);
       turn_off += rms_error_between(s, fair_causal(s.input, off).poses.orientation, 14.9, 16.0);
     }
-    EXPECT_LT(turn, 1.05 * turn_off);
+    EXPECT_LT(turn, 1.08 * turn_off);
   }
 }
 
@@ -530,9 +536,14 @@ TEST(Adaptation, AFastShakeIsFollowedNotSmoothedAway) {
 TEST(Adaptation, AQuickTurnIsTakenAtOnce) {
   // A head turned 60° in 0.1–0.15 s every 2 s, on a slow sway. Averaged in over 0.1 s, the
   // turn was over before the motion estimate saw it, and it was smoothed as hard as the sway:
-  // 3.5% above raw's error at 100 Hz and 2.4% below at 250 Hz. A fit that jumps over the motion
-  // average, twice running and growing, is taken at once: now 10% and 23% below raw.
-  for (const auto& [rate, seconds, sigma] : {std::tuple{100.0, 0.15, 0.005}, std::tuple{250.0, 0.1, 0.01}}) {
+  // 3.5% above raw's error at 100 Hz, 2.4% below at 250 Hz, 8% and 30% above at 60 and 90 Hz. A
+  // fit that jumps over the motion average, twice running and growing, is taken at once, and
+  // its size from the newest half span (which the long fit sees only dimly at its newest end):
+  // now 25% and 39% below raw, level with raw at 60 Hz and 7% above at 90 Hz. (Only the onset
+  // rule, with the long fit's size: 11% and 23% below, 8% and 30% above.)
+  for (const auto& [rate, seconds, sigma, bound] :
+       {std::tuple{100.0, 0.15, 0.005, 0.85}, std::tuple{250.0, 0.1, 0.01, 0.7}, std::tuple{60.0, 0.1, 0.003, 1.03},
+        std::tuple{90.0, 0.1, 0.002, 1.15}}) {
     SCOPED_TRACE(std::to_string(rate) + " Hz, turns of " + std::to_string(seconds) + " s");
     double raw = 0.0, smoothed = 0.0;
     for (std::uint64_t seed = 1; seed <= 3; ++seed) {
@@ -553,7 +564,7 @@ TEST(Adaptation, AQuickTurnIsTakenAtOnce) {
       raw += rms_error_between(s, s.input.orientation, 1.0, 20.0);
       smoothed += rms_error_between(s, fair_causal(s.input, WindowConfig{}).poses.orientation, 1.0, 20.0);
     }
-    EXPECT_LT(smoothed, 0.95 * raw);
+    EXPECT_LT(smoothed, bound * raw);
   }
 }
 
@@ -589,6 +600,42 @@ TEST(Adaptation, AGlitchIsNotTakenForAFastMotion) {
       return sum / n;
     };
     EXPECT_LT(mean_cutoff(glitched), 1.1 * mean_cutoff(clean));
+  }
+}
+
+TEST(Adaptation, TwoOutliersTogetherAreNotTakenForAQuickMotion) {
+  // Two outliers next to each other put the long fit over the onset threshold twice running and
+  // growing, as a quick motion starting does. The size then taken comes from the newest half
+  // span's fit of the running median of three, which drops them: the motion estimate rises about
+  // as far as for one outlier (7 times as far here; with the half span's fit of the samples
+  // themselves, 350 times, a pass-through for a third of a second).
+  const double rate = 100.0;
+  auto highest_motion_after = [&](double first, double second, std::uint64_t seed) {
+    MotionNoiseEstimator estimator(256, 2);
+    estimator.configure(rate, AdaptationSettings{}, 50);
+    std::mt19937 random(static_cast<std::mt19937::result_type>(seed));
+    std::normal_distribution<double> noise(0.0, 0.005);
+    std::vector<Vec3> zeta;
+    Vec3 last = Vec3::Zero();
+    const int at = 300;  // 3 s in: the estimates have settled
+    double highest = 0.0;
+    for (int i = 0; i < at + 20; ++i) {
+      const double t = i / rate;
+      Vec3 theta(0.3 * std::sin(2.0 * std::numbers::pi * 0.4 * t), 0.2 * std::sin(2.0 * std::numbers::pi * 0.3 * t), 0.0);
+      theta += Vec3(noise(random), noise(random), noise(random));
+      if (i == at) theta.x() += first;
+      if (i == at + 1) theta.y() += second;
+      if (i > 0) zeta.push_back(theta - last);
+      last = theta;
+      if (zeta.size() > 255) zeta.erase(zeta.begin());
+      if (!zeta.empty()) estimator.update(zeta, 1.0 / rate);
+      if (i >= at) highest = std::max(highest, estimator.motion_variance());
+    }
+    return highest;
+  };
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    EXPECT_LT(highest_motion_after(0.15, 0.29, seed), 20.0 * highest_motion_after(0.0, 0.29, seed));
   }
 }
 

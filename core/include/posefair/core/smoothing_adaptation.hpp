@@ -88,7 +88,9 @@ class MotionNoiseEstimator {
   // Moving, a fit whose excess over its noise is this many times the motion's (or the noise's,
   // if larger), twice running and growing, is a faster motion starting (a head turned quickly):
   // taken at once too. Averaged in, a 60° turn in 0.1–0.15 s was over before the average saw
-  // it, and was smoothed as hard as the slow motion before it.
+  // it, and was smoothed as hard as the slow motion before it. At either onset the size taken is
+  // the larger of the fit's and the newest half span's (of the running median of three, where it
+  // stands kFastMotionFactor times over its noise): the long fit sees the newest end dimly.
   static constexpr double kMotionOnsetFactor = 4.0;
   // The fit over motion_span_s averages away a fast motion (a 6–8 Hz shake, which a quadratic
   // over 0.25 s cannot follow), and the stream was then smoothed below the shake: two to five
@@ -105,6 +107,8 @@ class MotionNoiseEstimator {
 
  private:
   void update_noise(double length, double dt);
+  // The fit over the newest half span of the samples' running median of three, its mean square.
+  double newest_half_fit_of_medians(std::span<const Vec3> zeta) const;
 
   int order_;
   int capacity_;
