@@ -204,7 +204,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
         double taken = sample;
         if (short_span_ > 0) {
           const double newest = newest_half_fit_of_medians(zeta);
-          if (newest > kFastMotionFactor * short_noise) taken = std::max(taken, newest - short_noise + fit_noise);
+          if (newest > kOnsetSizeFactor * short_noise) taken = std::max(taken, newest - short_noise + fit_noise);
         }
         mean_square_ = std::max(mean_square_, taken);
       }

@@ -415,7 +415,7 @@ TEST(Adaptation, AMotionStartingFromRestIsTakenAtOnce) {
   // smoothing the turn's start as hard as the rest. A fit far over its noise, twice running and
   // growing, is taken at once: the turn out of rest is followed within 8% of the engine with
   // the rest test off (which takes a quicker motion at once too, kMotionOnsetFactor, and a fit
-  // or two sooner; summed over seeds: +5.8% and +3.3% at 100 and 250 Hz; without the rule at rest
+  // or two sooner; summed over seeds: +5.2% and +3.1% at 100 and 250 Hz; without the rule at rest
   // +12% and +15%. Before the onset's size came from the newest half span: +4% and +2%, and
   // +7.5% and +8.9%: both engines follow the turn sooner now, the one without rest most).
   for (const double rate : {100.0, 250.0}) {
