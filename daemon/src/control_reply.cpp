@@ -47,6 +47,37 @@ std::string member(std::string_view name, const std::string& value) {
   return out;
 }
 
+// [stream.spline]'s counters: null when neither bridging nor resampling is configured, and a
+// part that is not configured is null (as the counter line leaves it out).
+std::string spline_object(const StreamStats& s) {
+  if (!s.bridging && !s.resampling) return "null";
+  const auto count_if = [](bool configured, std::uint64_t v) { return configured ? std::to_string(v) : std::string("null"); };
+  return JsonObject()
+      .add("bridged_gaps", count_if(s.bridging, s.bridged_gaps))
+      .add("bridged_samples", count_if(s.bridging, s.bridged_samples))
+      .add("passed_through", count_if(s.bridging, s.unbridged_gaps))
+      .add("resampled", count_if(s.resampling, s.resampled))
+      .add("lerp_fallbacks", count_if(s.matrix_lerp, s.lerp_fallbacks))
+      .str();
+}
+
+// The device link's health, as the counter line's device part.
+std::string device_object(const drivers::DeviceHealth& d) {
+  return JsonObject()
+      .add("connected", d.connected)
+      .add("outages", d.outages)
+      .add("reconnects", d.reconnects)
+      .add("open_failures", d.open_failures)
+      .add("read_errors", d.read_errors)
+      .add("frames", d.frames)
+      .add("bad_frames", d.bad_frames)
+      .add("resyncs", d.resyncs)
+      .add("skipped_bytes", d.skipped_bytes)
+      .add("device_time_trusted", d.device_time_trusted)
+      .add("time_fallbacks", d.time_fallbacks)
+      .str();
+}
+
 }  // namespace
 
 std::string json_string(std::string_view s) {
@@ -134,8 +165,11 @@ std::string streams_member(const std::vector<StreamStats>& now, const std::vecto
                 .add("send_failures", s.send_failures)
                 .add("recorded", s.recorded)
                 .add("record_dropped", s.record_dropped)
+                .add("raw_unfused", s.raw_unfused)
                 .add("latency_us", latency)
                 .add("engine", engine)
+                .add("spline", spline_object(s))
+                .add("device", s.device ? device_object(*s.device) : "null")
                 .str();
   }
   list += ']';

@@ -85,6 +85,35 @@ TEST(StatusReport, GapsBridgedAndPassedThroughShowWhenBridging) {
   EXPECT_NE(lines[0].find(", bridged gaps 2 (samples 30, passed through 1)"), std::string::npos) << lines[0];
 }
 
+// `posefair ctl streams --json` carries what the counter line does: the raw-only samples (so
+// that received = dropped + rejected + out of order + raw-only + emitted + held back can be
+// checked from it), the spline's counters where configured, and the device's health.
+TEST(StatusReport, TheControlReplyCarriesTheSplineAndDeviceCounters) {
+  StreamStats s = stream(1, "head", 2000);
+  s.raw_unfused = 4;
+  s.bridged_gaps = 2;
+  s.bridged_samples = 30;
+  s.unbridged_gaps = 1;
+  s.resampled = 500;
+  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("raw_unfused":4,)"), std::string::npos) << streams_member({s}, {}, 1.0);
+  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("spline":null,"device":null})"), std::string::npos) << "neither configured";
+  s.bridging = true;
+  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("spline":{"bridged_gaps":2,"bridged_samples":30,"passed_through":1,)"
+                                              R"("resampled":null,"lerp_fallbacks":null})"),
+            std::string::npos)
+      << streams_member({s}, {}, 1.0);
+  s.resampling = true;
+  s.matrix_lerp = true;
+  s.lerp_fallbacks = 3;
+  s.device = drivers::DeviceHealth{false, 1, 1, 3, 0, 2000, 2, 3, 41, true, 0};
+  const std::string json = streams_member({s}, {}, 1.0);
+  EXPECT_NE(json.find(R"("resampled":500,"lerp_fallbacks":3})"), std::string::npos) << json;
+  EXPECT_NE(json.find(R"("device":{"connected":false,"outages":1,"reconnects":1,"open_failures":3,"read_errors":0,"frames":2000,)"
+                      R"("bad_frames":2,"resyncs":3,"skipped_bytes":41,"device_time_trusted":true,"time_fallbacks":0})"),
+            std::string::npos)
+      << json;
+}
+
 TEST(StatusReport, AGyroFromAnotherStreamShowsItsSourceAndMatches) {
   StreamStats s = stream(1, "optical", 100);
   s.gyro_pairing = GyroPairingStats{"imu", 0, 100};
