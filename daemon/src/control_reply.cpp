@@ -78,6 +78,47 @@ std::string device_object(const drivers::DeviceHealth& d) {
       .str();
 }
 
+// [stream.fusion]'s estimator, as the counter line's fusion part (the bias in rad/s).
+std::string fusion_object(const EstimatorState& f, std::uint64_t waiting) {
+  return JsonObject()
+      .add("initialised", f.initialised)
+      .number("gyro_bias_x_rad_s", f.gyro_bias.x())
+      .number("gyro_bias_y_rad_s", f.gyro_bias.y())
+      .number("gyro_bias_z_rad_s", f.gyro_bias.z())
+      .add("at_rest", f.at_rest)
+      .add("field_disturbed", f.mag_disturbed)
+      .add("waiting", waiting)
+      .add("updates", f.updates)
+      .add("non_finite", f.nonfinite)
+      .add("gyro_saturated", f.gyro_saturated)
+      .add("mag_stuck", f.mag_stuck)
+      .add("mag_absent", f.mag_absent)
+      .add("bad_time_steps", f.bad_time_steps)
+      .add("gaps", f.gaps)
+      .add("state_resets", f.state_resets)
+      .str();
+}
+
+// [stream.gpio]'s lines, as the counter line's gpio parts.
+std::string data_ready_object(const drivers::GpioDataReadyCounters& d) {
+  const drivers::EdgePairingCounters& p = d.pairing;
+  return JsonObject()
+      .add("held", d.line_held)
+      .add("edges", p.edges)
+      .add("paired", p.paired)
+      .add("missing", p.missing)
+      .add("extra", p.extra_edges)
+      .add("late", p.late_edges)
+      .add("overflow", p.overflow)
+      .add("request_failures", d.request_failures)
+      .add("losses", d.losses)
+      .str();
+}
+
+std::string gpio_output_object(const drivers::GpioOutputCounters& o) {
+  return JsonObject().add("held", o.line_held).add("toggles", o.toggles).add("errors", o.errors).str();
+}
+
 }  // namespace
 
 std::string json_string(std::string_view s) {
@@ -170,6 +211,9 @@ std::string streams_member(const std::vector<StreamStats>& now, const std::vecto
                 .add("engine", engine)
                 .add("spline", spline_object(s))
                 .add("device", s.device ? device_object(*s.device) : "null")
+                .add("fusion", s.fusion ? fusion_object(*s.fusion, s.fusion_waiting) : "null")
+                .add("gpio_data_ready", s.data_ready ? data_ready_object(*s.data_ready) : "null")
+                .add("gpio_output", s.gpio_output ? gpio_output_object(*s.gpio_output) : "null")
                 .str();
   }
   list += ']';

@@ -96,7 +96,7 @@ TEST(StatusReport, TheControlReplyCarriesTheSplineAndDeviceCounters) {
   s.unbridged_gaps = 1;
   s.resampled = 500;
   EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("raw_unfused":4,)"), std::string::npos) << streams_member({s}, {}, 1.0);
-  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("spline":null,"device":null})"), std::string::npos) << "neither configured";
+  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("spline":null,"device":null,")"), std::string::npos) << "neither configured";
   s.bridging = true;
   EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("spline":{"bridged_gaps":2,"bridged_samples":30,"passed_through":1,)"
                                               R"("resampled":null,"lerp_fallbacks":null})"),
@@ -110,6 +110,38 @@ TEST(StatusReport, TheControlReplyCarriesTheSplineAndDeviceCounters) {
   EXPECT_NE(json.find(R"("resampled":500,"lerp_fallbacks":3})"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("device":{"connected":false,"outages":1,"reconnects":1,"open_failures":3,"read_errors":0,"frames":2000,)"
                       R"("bad_frames":2,"resyncs":3,"skipped_bytes":41,"device_time_trusted":true,"time_fallbacks":0})"),
+            std::string::npos)
+      << json;
+}
+
+// And the fusion stage's and the GPIO lines' counters, null where not configured.
+TEST(StatusReport, TheControlReplyCarriesTheFusionAndGpioCounters) {
+  StreamStats s = stream(1, "imu", 2000);
+  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("fusion":null,"gpio_data_ready":null,"gpio_output":null})"), std::string::npos)
+      << streams_member({s}, {}, 1.0);
+  EstimatorState f;
+  f.initialised = true;
+  f.at_rest = true;
+  f.updates = 1990;
+  f.mag_stuck = 2;
+  f.gaps = 1;
+  s.fusion = f;
+  s.fusion_waiting = 10;
+  drivers::GpioDataReadyCounters in;
+  in.line_held = true;
+  in.pairing.edges = 300;
+  in.pairing.paired = 298;
+  in.pairing.missing = 2;
+  in.losses = 1;
+  s.data_ready = in;
+  s.gpio_output = drivers::GpioOutputCounters{true, 298, 0};
+  const std::string json = streams_member({s}, {}, 1.0);
+  EXPECT_NE(json.find(R"("at_rest":true,"field_disturbed":false,"waiting":10,"updates":1990,"non_finite":0,"gyro_saturated":0,)"
+                      R"("mag_stuck":2,"mag_absent":0,"bad_time_steps":0,"gaps":1,"state_resets":0})"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find(R"("gpio_data_ready":{"held":true,"edges":300,"paired":298,"missing":2,"extra":0,"late":0,"overflow":0,)"
+                      R"("request_failures":0,"losses":1},"gpio_output":{"held":true,"toggles":298,"errors":0}})"),
             std::string::npos)
       << json;
 }
