@@ -364,9 +364,9 @@ TEST(Adaptation, AStillStreamIsSmoothedHardAndTheMotionAfterItIsNot) {
   // (half the noise left). A line through the window that sees no slope either lets it go: a
   // third less error at rest, and the turn out of rest costs little more than with the rest
   // test off. (That engine takes the turn's start a fit or two sooner, at about 5 times the
-  // noise instead of 8, and since the onset's size comes from the newest half span a fit sooner counts
-  // for more: 11% and 5% more at 100 and 250 Hz, 2% less at 30 Hz; 22% and 21% more without
-  // taking a motion starting at rest at once.)
+  // noise instead of 8, and since the onset's size comes from the newest half span a fit
+  // sooner counts for more: 11% and 5% more at 100 and 250 Hz, 2% less at 30 Hz; 22% and 21%
+  // more without taking a motion starting at rest at once.)
   for (const double rate : {30.0, 100.0, 250.0}) {
     SCOPED_TRACE(std::to_string(rate) + " Hz");
     const Stream s = still_then_turn(rate, 0.006, 5);
