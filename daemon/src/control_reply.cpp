@@ -51,13 +51,13 @@ std::string member(std::string_view name, const std::string& value) {
 // part that is not configured is null (as the counter line leaves it out).
 std::string spline_object(const StreamStats& s) {
   if (!s.bridging && !s.resampling) return "null";
-  const auto count_if = [](bool configured, std::uint64_t v) { return configured ? std::to_string(v) : std::string("null"); };
+  const auto if_configured = [](bool configured, std::uint64_t v) { return configured ? std::to_string(v) : std::string("null"); };
   return JsonObject()
-      .add("bridged_gaps", count_if(s.bridging, s.bridged_gaps))
-      .add("bridged_samples", count_if(s.bridging, s.bridged_samples))
-      .add("passed_through", count_if(s.bridging, s.unbridged_gaps))
-      .add("resampled", count_if(s.resampling, s.resampled))
-      .add("lerp_fallbacks", count_if(s.matrix_lerp, s.lerp_fallbacks))
+      .add("bridged_gaps", if_configured(s.bridging, s.bridged_gaps))
+      .add("bridged_samples", if_configured(s.bridging, s.bridged_samples))
+      .add("passed_through", if_configured(s.bridging, s.unbridged_gaps))
+      .add("resampled", if_configured(s.resampling, s.resampled))
+      .add("lerp_fallbacks", if_configured(s.matrix_lerp, s.lerp_fallbacks))
       .str();
 }
 
