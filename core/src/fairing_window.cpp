@@ -119,6 +119,8 @@ void validate(const WindowConfig& c) {
     if (!(t > 0.0 && t <= kMaxAdaptationTime)) bad(S::Adaptation, "the adaptation's time constants must be in (0, 600] seconds");
   if (!(a.rest_threshold >= 0.0 && a.rest_threshold <= kMaxRestThreshold))
     bad(S::Adaptation, "the rest threshold must be in [0, 100]");
+  if (!(a.rest_memory_s >= 0.0 && a.rest_memory_s <= kMaxAdaptationTime))
+    bad(S::Adaptation, "the rest memory must be in [0, 600] seconds (0: off)");
   if (!(a.motion_margin > 0.0 && a.motion_margin <= kMaxMotionMargin))
     bad(S::Adaptation, "the adaptation's motion margin must be in (0, 100]");
   if (!(c.continuity >= 0.0) || !std::isfinite(c.continuity)) bad(S::Continuity, "continuity must be finite and >= 0");
@@ -404,6 +406,7 @@ EngineState FairingWindow::state() const {
       out.noise = unit * std::sqrt(3.0 * estimator.noise_variance());
       out.at_rest = estimator.at_rest();
       out.motion = dt > 0.0 ? unit * std::sqrt(3.0 * estimator.motion_variance()) / std::pow(dt, config_.order) : 0.0;
+      out.rest_averaged = ch.rest_averaged;
     }
   }
   return s;
@@ -413,9 +416,77 @@ void FairingWindow::linear_emission_estimate(int k, double dt) {
   const auto d = static_cast<std::size_t>(std::max(0, n_ - 1));
   adapt(rot_, std::span<const Vec3>(rotation_increments()).first(d), dt);
   if (positions_) adapt(pos_, std::span<const Vec3>(dzp_).first(d), dt);
+  follow_rest(rot_, rotation_increments());
+  if (positions_) follow_rest(pos_, dzp_);
   if (k < 0) return;
-  est_[static_cast<std::size_t>(k)] = linear_correction(rot_, rotation_increments(), c_);
-  if (positions_) xp_[static_cast<std::size_t>(k)] = zp_[static_cast<std::size_t>(k)] + linear_correction(pos_, dzp_, cp_);
+  const auto i = static_cast<std::size_t>(k);
+  est_[i] = rest_blend(rot_, rotation_increments(), k, linear_correction(rot_, rotation_increments(), c_), dt);
+  if (positions_) xp_[i] = zp_[i] + rest_blend(pos_, dzp_, k, linear_correction(pos_, dzp_, cp_), dt);
+}
+
+// At rest, the channel's samples also feed a line with a memory of seconds (rest_line.hpp),
+// taken while no motion is seen (the heaviest level). Its coordinate is the sum of the
+// increments since it began, the linear solver's own (x_i = z_i exp(e_i), θ_i + e_i the path).
+void FairingWindow::follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta) {
+  const double memory = config_.adaptation.rest_memory_s;
+  const bool still = ch.adaptive && prepared_ && memory > 0.0 && !(&ch == &rot_ && aided_) && n_ == w_ &&
+                     ch.estimator.at_rest();
+  if (!still) {
+    ch.resting = false;
+    return;
+  }
+  auto feed = [&](int from) {
+    for (int i = from; i < n_; ++i) {
+      const auto j = static_cast<std::size_t>(i);
+      if (i > 0 && !ch.rest_line.empty()) ch.rest_theta += zeta[j - 1];
+      ch.rest_line.add(i > 0 ? samples_[j].time - samples_[j - 1].time : 0.0, ch.rest_theta, memory);
+    }
+    ch.rest_time = samples_[static_cast<std::size_t>(n_ - 1)].time;
+  };
+  if (ch.resting) {
+    feed(n_ - 1);
+    return;
+  }
+  // The rest begins again. Where the rest test let go of it only for a moment (the window's
+  // slope is noisy too, so it does now and then), the line takes the samples it missed from the
+  // window and goes on, if it is still straight; otherwise it starts from the window's samples.
+  int last = -1;
+  if (!ch.rest_line.empty())
+    for (int i = n_ - 1; i >= 0 && last < 0; --i)
+      if (samples_[static_cast<std::size_t>(i)].time == ch.rest_time) last = i;
+  if (last >= 0) feed(last + 1);
+  const std::optional<RestLine::Value> value = ch.rest_line.value_at(0.0, ch.estimator.noise_variance(), kRestLineFactor);
+  if (last < 0 || !value || !value->straight) {
+    ch.rest_line.reset();
+    ch.rest_theta = Vec3::Zero();
+    feed(0);
+  }
+  ch.resting = true;
+}
+
+// Sample k's correction (in its chart, as linear_correction's): the window's, moved toward the
+// rest line's while the line is straight, and back while it is not, over motion_time_s (a
+// switch would step the output, and a stream at the edge of rest switches often). A motion
+// seen at rest takes the window's at once, as leaving rest does.
+Vec3 FairingWindow::rest_blend(Channel& ch, const SlidingArray<Vec3>& zeta, int k, const Vec3& window, double dt) {
+  ch.rest_averaged = false;
+  const auto newest = static_cast<std::size_t>(n_ - 1);
+  const double age = samples_[newest].time - samples_[static_cast<std::size_t>(k)].time - config_.horizon_s;
+  const std::optional<RestLine::Value> value =
+      ch.resting && ch.estimator.motion_variance() == 0.0
+          ? ch.rest_line.value_at(age, ch.estimator.noise_variance(), kRestLineFactor)
+          : std::nullopt;
+  if (!value) {
+    ch.rest_weight = 0.0;
+    return window;
+  }
+  ch.rest_averaged = value->straight;
+  const double target = value->straight ? 1.0 : 0.0;
+  ch.rest_weight += (target - ch.rest_weight) * (1.0 - std::exp(-std::max(dt, 0.0) / config_.adaptation.motion_time_s));
+  if (!(ch.rest_weight > 0.0)) return window;
+  Vec3 theta_k = ch.rest_theta;
+  for (int j = k; j < n_ - 1; ++j) theta_k -= zeta[static_cast<std::size_t>(j)];
+  return window + ch.rest_weight * (value->line - theta_k - window);
 }
 
 // Constant angular (and linear) velocity from the last accepted measurement to the newest,

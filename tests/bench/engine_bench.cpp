@@ -3,9 +3,11 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
+#include <random>
 
 #include "posefair/core/fairing_window.hpp"
 #include "posefair/core/one_euro_filter.hpp"
+#include "posefair/core/pose_sequence.hpp"
 #include "posefair/core/synthetic_motion.hpp"
 
 namespace posefair {
@@ -30,8 +32,22 @@ const SyntheticMotion& stream(bool with_position) {
   return with_position ? posed : plain;
 }
 
-void run_window(benchmark::State& state, WindowConfig c, bool with_position) {
-  const auto& m = stream(with_position);
+// A tracker lying still: 1 kHz, noise of 0.01 rad per axis.
+const PoseSequence& still_stream() {
+  static const PoseSequence still = [] {
+    std::mt19937_64 rng(1);
+    std::normal_distribution<double> noise(0.0, 0.01);
+    PoseSequence p;
+    for (int i = 0; i < 20000; ++i) {
+      p.time.push_back(i * 0.001);
+      p.orientation.push_back(so3::from_rotation_vector(Vec3(noise(rng), noise(rng), noise(rng))));
+    }
+    return p;
+  }();
+  return still;
+}
+
+void run_window(benchmark::State& state, WindowConfig c, const PoseSequence& input, bool with_position) {
   FairingWindow w(c);
   std::vector<FairedPose> out(static_cast<std::size_t>(w.max_outputs_per_push()));
   std::size_t i = 0;
@@ -40,14 +56,14 @@ void run_window(benchmark::State& state, WindowConfig c, bool with_position) {
     Sample s;
     s.time = t;
     t += 0.001;
-    s.orientation = m.noisy.orientation[i];
+    s.orientation = input.orientation[i];
     if (with_position) {
-      s.position = m.noisy.position[i];
+      s.position = input.position[i];
       s.flags = kHasPosition;
     }
     benchmark::DoNotOptimize(w.push(s, out));
     benchmark::DoNotOptimize(out[0].orientation);
-    if (++i == m.noisy.size()) i = 0;
+    if (++i == input.size()) i = 0;
   }
   state.SetItemsProcessed(state.iterations());
   state.counters["bytes_per_stream"] = static_cast<double>(w.memory_bytes());
@@ -60,7 +76,7 @@ void BM_Linear(benchmark::State& state) {
   c.order = static_cast<int>(state.range(1));
   c.continuity = static_cast<double>(state.range(2));
   c.smoothing_r = c.smoothing_t = smoothing_for_cutoff(4.0, 1000.0, c.order);
-  run_window(state, c, state.range(3) != 0);
+  run_window(state, c, stream(state.range(3) != 0).noisy, state.range(3) != 0);
 }
 
 // The defaults (adapted smoothing, W = 0.5 s at 1 kHz capped at 128), optionally with
@@ -68,9 +84,18 @@ void BM_Linear(benchmark::State& state) {
 void BM_Defaults(benchmark::State& state) {
   WindowConfig c;
   if (state.range(1) != 0) c.horizon_s = 0.02;
-  run_window(state, c, state.range(0) != 0);
+  run_window(state, c, stream(state.range(0) != 0).noisy, state.range(0) != 0);
 }
 BENCHMARK(BM_Defaults)->ArgNames({"pos", "horizon"})->Args({0, 0})->Args({1, 0})->Args({0, 1});
+
+// The defaults on a still stream: at rest, the window's output blended with the rest line
+// (rest_line.hpp), against rest_memory 0 (the window's heaviest level alone).
+void BM_DefaultsAtRest(benchmark::State& state) {
+  WindowConfig c;
+  c.adaptation.rest_memory_s = state.range(0) != 0 ? 1.0 : 0.0;
+  run_window(state, c, still_stream(), false);
+}
+BENCHMARK(BM_DefaultsAtRest)->ArgNames({"rest_line"})->Arg(1)->Arg(0);
 BENCHMARK(BM_Linear)
     ->ArgNames({"W", "m", "kappa", "pos"})
     ->Args({32, 2, 0, 0})  // the old default
@@ -88,7 +113,7 @@ void BM_GaussNewton(benchmark::State& state) {
   c.iterations = static_cast<int>(state.range(1));
   c.solver = WindowSolver::GaussNewton;
   c.smoothing_r = smoothing_for_cutoff(4.0, 1000.0, 2);
-  run_window(state, c, false);
+  run_window(state, c, stream(false).noisy, false);
 }
 BENCHMARK(BM_GaussNewton)->ArgNames({"W", "K"})->Args({16, 1})->Args({32, 1})->Args({32, 2});
 
@@ -97,7 +122,7 @@ void BM_PaperSweeps(benchmark::State& state) {
   c.window = static_cast<int>(state.range(0));
   c.iterations = static_cast<int>(state.range(1));
   c.solver = WindowSolver::DampedSweeps;
-  run_window(state, c, false);
+  run_window(state, c, stream(false).noisy, false);
 }
 BENCHMARK(BM_PaperSweeps)->ArgNames({"W", "K"})->Args({16, 4})->Args({32, 4})->Args({32, 16});
 

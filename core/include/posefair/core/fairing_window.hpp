@@ -32,6 +32,7 @@
 #include "posefair/core/banded_cholesky.hpp"
 #include "posefair/core/fairing_operators.hpp"
 #include "posefair/core/gyro_aiding.hpp"
+#include "posefair/core/rest_line.hpp"
 #include "posefair/core/sample.hpp"
 #include "posefair/core/sample_gate.hpp"
 #include "posefair/core/sliding_array.hpp"
@@ -110,6 +111,7 @@ struct ChannelAdaptation {
   double smoothing = 0.0;  // μ in use
   double cutoff_hz = 0.0;  // the cutoff μ corresponds to at the rate (0 while the rate is unknown)
   bool at_rest = false;    // adapted: the stream is still, and smoothed as hard as the window allows (smoothing_adaptation.hpp)
+  bool rest_averaged = false;  // at rest and averaged over seconds, not the window (rest_line.hpp)
 };
 struct EngineState {
   double rate_hz = 0.0;    // given or measured; 0 until known
@@ -150,6 +152,15 @@ class FairingWindow {
     double level = 0.0;         // adapted: real index into levels_
     EmissionRow fixed;          // fixed μ: the full window's row
     MotionNoiseEstimator estimator;
+    // At rest (adapted): the line through the samples since the rest began, its newest
+    // coordinate (the sum of the increments since then) and time, whether the channel is at
+    // rest now, the line's weight in the output, and whether the line is straight.
+    RestLine rest_line;
+    Vec3 rest_theta = Vec3::Zero();
+    double rest_time = 0.0;
+    bool resting = false;
+    double rest_weight = 0.0;
+    bool rest_averaged = false;
   };
 
   void append(const Sample& s);
@@ -164,6 +175,8 @@ class FairingWindow {
   void slide(int count);
   void adapt(Channel& ch, std::span<const Vec3> zeta, double dt);
   Vec3 linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c);
+  void follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta);
+  Vec3 rest_blend(Channel& ch, const SlidingArray<Vec3>& zeta, int k, const Vec3& window, double dt);
   void linear_emission_estimate(int k, double dt);
   void predict_from_last_step(int k, double step);
   void check_continuity_stability() const;

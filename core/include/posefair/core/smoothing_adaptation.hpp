@@ -58,6 +58,11 @@ struct AdaptationSettings {
   // Under noise alone both mean squares are once that noise. 0: never at rest (the floor always
   // holds). Needs the floor: a gyro-aided residual has none to drop.
   double rest_threshold = 2.0;
+  // At rest, with no motion seen, the output is a line through every sample since the stream
+  // came to rest, older samples weighing e^(−age/rest_memory_s), while it stays straight
+  // (rest_line.hpp): a still pose averaged over seconds, not the window's half second.
+  // 0: the window's heaviest smoothing at rest.
+  double rest_memory_s = 1.0;
 };
 
 // Noise and motion of one channel (rotation or position), from its differences ζ.

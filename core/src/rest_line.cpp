@@ -1,0 +1,80 @@
+#include "posefair/core/rest_line.hpp"
+
+#include "posefair/core/combinatorics.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+namespace posefair {
+namespace {
+
+// Σ w·(a + dt)^k from Σ w·a^j, j ≤ k (the binomial expansion), in place from the top down.
+template <class T, std::size_t N>
+void age_by(std::array<T, N>& sums, double dt) {
+  for (int k = static_cast<int>(N) - 1; k >= 1; --k) {
+    T shifted = sums[static_cast<std::size_t>(k)];
+    double power = 1.0;
+    for (int j = k - 1; j >= 0; --j) {
+      power *= dt;
+      shifted += binomial(k, j) * power * sums[static_cast<std::size_t>(j)];
+    }
+    sums[static_cast<std::size_t>(k)] = shifted;
+  }
+}
+
+// The Hankel matrix of moments [s_{i+j}] of a fit with `size` coefficients.
+Eigen::Matrix3d moments(const std::array<double, 5>& s, int size) {
+  Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
+  for (int i = 0; i < size; ++i)
+    for (int j = 0; j < size; ++j) m(i, j) = s[static_cast<std::size_t>(i + j)];
+  return m;
+}
+
+}  // namespace
+
+void RestLine::reset() {
+  weights_ = {};
+  squares_ = {};
+  steps_ = 0;
+  values_ = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+}
+
+void RestLine::add(double dt, const Vec3& y, double memory_s) {
+  if (!empty() && dt > 0.0) {
+    age_by(weights_, dt);
+    age_by(squares_, dt);
+    age_by(values_, dt);
+    const double decay = std::exp(-dt / memory_s);
+    for (double& s : weights_) s *= decay;
+    for (double& s : squares_) s *= decay * decay;
+    for (Vec3& v : values_) v *= decay;
+    steps_ = std::min(steps_ + 1, 2);
+  }
+  weights_[0] += 1.0;
+  squares_[0] += 1.0;
+  values_[0] += y;
+}
+
+std::optional<RestLine::Value> RestLine::value_at(double age, double noise_var, double factor) const {
+  // Each fit's value at `age` is Σ w_i·(pᵀ[1, a_i, a_i²])·y_i with p = M⁻¹[1, age, age²] and M
+  // the fit's moments; the difference of the two fits has weights w_i·dᵀ[1, a_i, a_i²] with
+  // d = p_quadratic − p_line, and its noise gain is dᵀ[Σ w²a^(i+j)]d.
+  if (steps_ < 2) return std::nullopt;  // fewer than three distinct times: no quadratic
+  const Eigen::Matrix3d quadratic = moments(weights_, 3);
+  const Eigen::LDLT<Eigen::Matrix3d> q(quadratic);
+  if (q.info() != Eigen::Success || !(q.rcond() > 1e-12)) return std::nullopt;
+  const Eigen::Matrix3d line = moments(weights_, 2);
+  const Eigen::LDLT<Eigen::Matrix3d> l(line);
+  const Eigen::Vector3d at(1.0, age, age * age);
+  const Eigen::Vector3d p_quadratic = q.solve(at);
+  Eigen::Vector3d p_line = l.solve(Eigen::Vector3d(1.0, age, 0.0));
+  p_line(2) = 0.0;
+  const Eigen::Vector3d d = p_quadratic - p_line;
+  const double gain = d.dot(moments(squares_, 3) * d);
+  const Vec3 difference = d(0) * values_[0] + d(1) * values_[1] + d(2) * values_[2];
+  return Value{p_line(0) * values_[0] + p_line(1) * values_[1], difference.squaredNorm() / 3.0 < factor * noise_var * gain};
+}
+
+}  // namespace posefair

@@ -1,0 +1,109 @@
+// The line a still stream is averaged with (core/include/posefair/core/rest_line.hpp): its
+// recursive sums against the weighted least-squares line computed directly, and its
+// straightness check against what noise alone and a bend put there.
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include "posefair/core/rest_line.hpp"
+
+namespace posefair {
+namespace {
+
+// The least-squares line through (t_i, y_i) with weights e^(−age/memory), at `age` before the
+// newest sample, solved directly.
+Vec3 direct_line(const std::vector<double>& t, const std::vector<Vec3>& y, double memory, double age) {
+  Eigen::Matrix2d m = Eigen::Matrix2d::Zero();
+  Eigen::Matrix<double, 2, 3> r = Eigen::Matrix<double, 2, 3>::Zero();
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const double a = t.back() - t[i];
+    const double w = std::exp(-a / memory);
+    const Eigen::Vector2d x(1.0, a);
+    m += w * x * x.transpose();
+    r += w * x * y[i].transpose();
+  }
+  const Eigen::Matrix<double, 2, 3> c = m.ldlt().solve(r);
+  return (c.row(0) + age * c.row(1)).transpose();
+}
+
+TEST(RestLine, IsTheWeightedLeastSquaresLineThroughItsSamples) {
+  // Irregular steps and noisy values: the recursive sums give the line a direct solve gives, at
+  // the newest sample, behind it and ahead of it (a prediction).
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> step(0.005, 0.015);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  RestLine line;
+  std::vector<double> t;
+  std::vector<Vec3> y;
+  double time = 0.0;
+  for (int i = 0; i < 400; ++i) {
+    const double dt = i == 0 ? 0.0 : step(rng);
+    time += dt;
+    t.push_back(time);
+    y.emplace_back(0.1 + 0.02 * time + noise(rng), -0.3 + noise(rng), noise(rng));
+    line.add(dt, y.back(), 1.0);
+  }
+  for (const double age : {0.0, 0.05, -0.02}) {
+    SCOPED_TRACE("age " + std::to_string(age));
+    const std::optional<RestLine::Value> v = line.value_at(age, 1.0, kRestLineFactor);
+    ASSERT_TRUE(v.has_value());
+    EXPECT_LT((v->line - direct_line(t, y, 1.0, age)).norm(), 1e-9);
+  }
+}
+
+TEST(RestLine, NoiseAlonePassesTheCheckAsOftenAsItsFactorSays) {
+  // Under white noise the two fits' difference, per component and in units of the noise its
+  // weights carry, is a χ² with 3 degrees of freedom over 3: under kRestLineFactor (3) 97% of the
+  // time. A noise gain off by a factor of 2 either way would pass 79% or 99.96% of the time.
+  std::mt19937_64 rng(11);
+  const double sigma = 0.01;
+  std::normal_distribution<double> noise(0.0, sigma);
+  // The gain is exact for whatever weights the line holds, so each run of 3 s is one check.
+  int checks = 0, straight = 0;
+  for (int run = 0; run < 1000; ++run) {
+    RestLine line;
+    for (int i = 0; i < 300; ++i) line.add(i == 0 ? 0.0 : 0.01, Vec3(noise(rng), noise(rng), noise(rng)), 1.0);
+    ++checks;
+    straight += line.value_at(0.0, sigma * sigma, kRestLineFactor)->straight ? 1 : 0;
+  }
+  const double share = static_cast<double>(straight) / checks;
+  EXPECT_GT(share, 0.94);
+  EXPECT_LT(share, 0.99);
+}
+
+TEST(RestLine, ABendIsSeenAndAStraightDriftIsNot) {
+  // A constant drift is a line: taken, and exact. A constant acceleration that a line with a
+  // memory of 1 s would follow a·τ² behind (0.01 rad here, 45 times the noise it keeps) is not.
+  RestLine drift, bend;
+  const double sigma = 0.002;
+  for (int i = 0; i < 300; ++i) {
+    const double t = 0.01 * i;
+    drift.add(i == 0 ? 0.0 : 0.01, Vec3(0.01 * t, 0.0, 0.0), 1.0);
+    bend.add(i == 0 ? 0.0 : 0.01, Vec3(0.5 * 0.01 * t * t, 0.0, 0.0), 1.0);
+  }
+  const std::optional<RestLine::Value> v = drift.value_at(0.0, sigma * sigma, kRestLineFactor);
+  ASSERT_TRUE(v.has_value());
+  EXPECT_TRUE(v->straight);
+  EXPECT_NEAR(v->line.x(), 0.01 * 2.99, 1e-12);
+  EXPECT_FALSE(bend.value_at(0.0, sigma * sigma, kRestLineFactor)->straight);
+}
+
+TEST(RestLine, NeedsThreeDistinctTimes) {
+  RestLine line;
+  EXPECT_TRUE(line.empty());
+  line.add(0.0, Vec3::Zero(), 1.0);
+  line.add(0.0, Vec3::Ones(), 1.0);  // a duplicate time stamp
+  line.add(0.01, Vec3::Ones(), 1.0);
+  EXPECT_FALSE(line.value_at(0.0, 1.0, kRestLineFactor).has_value());
+  line.add(0.01, Vec3::Ones(), 1.0);
+  EXPECT_TRUE(line.value_at(0.0, 1.0, kRestLineFactor).has_value());
+  line.reset();
+  EXPECT_TRUE(line.empty());
+}
+
+}  // namespace
+}  // namespace posefair
