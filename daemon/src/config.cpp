@@ -139,7 +139,7 @@ constexpr std::string_view kDaemonKeys[] = {"exit_when_sources_end", "session_id
 constexpr std::string_view kLoggingKeys[] = {"level", "target", "status_interval"};
 constexpr std::string_view kEngineKeys[] = {
     "window",   "window_time", "max_window", "lag", "horizon", "order", "solver", "iterations", "smoothing", "smoothing_r",
-    "smoothing_t", "cutoff_hz", "rate_hz", "noise_time", "motion_time", "motion_span", "motion_margin", "rest_threshold", "continuity",
+    "smoothing_t", "cutoff_hz", "rate_hz", "noise_time", "motion_time", "motion_span", "motion_margin", "rest_threshold", "rest_memory", "continuity",
     "lambda_r", "lambda_t", "variant",
     "epsilon_r", "epsilon_t", "bound",  "gap",       "gap_intervals", "unit_tolerance", "gyro_aided", "gyro_time_offset",
     "gyro_estimate_offset", "gyro_mounting", "gyro_stream"};
@@ -328,7 +328,7 @@ struct EngineLayer {
   std::optional<Given<double>> window_time, horizon, smoothing, smoothing_r, smoothing_t, cutoff_hz, rate_hz, continuity, lambda_r,
       lambda_t, epsilon_r, epsilon_t, gap, gap_intervals, unit_tolerance;
   // The adaptation's time constants and margin (core/smoothing_adaptation.hpp).
-  std::optional<Given<double>> noise_time, motion_time, motion_span, motion_margin, rest_threshold;
+  std::optional<Given<double>> noise_time, motion_time, motion_span, motion_margin, rest_threshold, rest_memory;
   std::optional<Given<OperatorVariant>> variant;
   std::optional<Given<BoundPolicy>> bound;
   // Gyro-aided fairing (core/gyro_aiding.hpp).
@@ -593,6 +593,7 @@ class Parser {
     real("motion_span", e.motion_span, adaptation_time);
     real("motion_margin", e.motion_margin, FloatRange{0.0, true, kMaxMotionMargin, false});
     real("rest_threshold", e.rest_threshold, FloatRange{0.0, false, kMaxRestThreshold, false});
+    real("rest_memory", e.rest_memory, FloatRange{0.0, false, kMaxAdaptationTime, false});
     real("continuity", e.continuity, kNonNegative);
     real("lambda_r", e.lambda_r, kUnitInterval);
     real("lambda_t", e.lambda_t, kUnitInterval);
@@ -682,6 +683,7 @@ class Parser {
       take(layer->motion_span, c.adaptation.motion_span_s, EngineSetting::Adaptation);
       take(layer->motion_margin, c.adaptation.motion_margin, EngineSetting::Adaptation);
       take(layer->rest_threshold, c.adaptation.rest_threshold, EngineSetting::Adaptation);
+      take(layer->rest_memory, c.adaptation.rest_memory_s, EngineSetting::Adaptation);
       if (layer->gyro_aided) c.gyro.enabled = layer->gyro_aided->value;
       if (layer->gyro_estimate_offset) c.gyro.estimate_time_offset = layer->gyro_estimate_offset->value;
       if (layer->gyro_time_offset) c.gyro.time_offset_s = layer->gyro_time_offset->value;

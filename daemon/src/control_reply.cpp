@@ -37,6 +37,7 @@ std::string channel(const ChannelAdaptation& c) {
       .number("smoothing", c.smoothing)
       .number("cutoff_hz", c.cutoff_hz)
       .add("at_rest", c.at_rest)
+      .add("rest_averaged", c.rest_averaged)
       .str();
 }
 

@@ -55,6 +55,11 @@ std::string gpio_text(const std::optional<drivers::GpioDataReadyCounters>& in,
   return text;
 }
 
+// A channel at rest, and averaged over seconds (the rest line, docs/engine.md "At rest").
+const char* rest_text(const ChannelAdaptation& a) {
+  return a.rest_averaged ? ", at rest, averaged over seconds" : a.at_rest ? ", at rest" : "";
+}
+
 // "; engine 285.7 Hz, window 128, rotation adapted: noise 0.0012 rad, motion 3.1 rad/s^2,
 //  cutoff 8.2 Hz (mu 352)" — the adaptation's measurements and choice, or the fixed smoothing.
 std::string engine_text(const EngineState& e, const std::optional<GyroPairingStats>& pairing, std::uint64_t gyro_bridged) {
@@ -68,7 +73,7 @@ std::string engine_text(const EngineState& e, const std::optional<GyroPairingSta
   auto channel = [&](const char* name, const ChannelAdaptation& a, const char* unit) {
     if (a.adaptive)
       std::snprintf(buf, sizeof buf, ", %s adapted: noise %.3g %s, motion %.3g %s/s^m, cutoff %.3g Hz (mu %.4g)%s", name,
-                    a.noise, unit, a.motion, unit, a.cutoff_hz, a.smoothing, a.at_rest ? ", at rest" : "");
+                    a.noise, unit, a.motion, unit, a.cutoff_hz, a.smoothing, rest_text(a));
     else
       std::snprintf(buf, sizeof buf, ", %s fixed: cutoff %.3g Hz (mu %.4g)", name, a.cutoff_hz, a.smoothing);
     text += buf;
@@ -167,7 +172,7 @@ std::string status_line(const std::vector<StreamStats>& now, const std::vector<S
     // What the smoothing is doing: its cutoff now (adapted or fixed), once the rate is known.
     if (s.engine.rate_hz > 0.0) {
       const ChannelAdaptation& r = s.engine.rotation;
-      std::snprintf(buf, sizeof buf, " fc %.3gHz%s", r.cutoff_hz, !r.adaptive ? "" : r.at_rest ? " (adapted, at rest)" : " (adapted)");
+      std::snprintf(buf, sizeof buf, " fc %.3gHz%s", r.cutoff_hz, !r.adaptive ? "" : r.rest_averaged ? " (adapted, at rest, averaged)" : r.at_rest ? " (adapted, at rest)" : " (adapted)");
       out += buf;
     }
     if (s.raw_unfused > 0) {

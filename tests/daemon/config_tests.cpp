@@ -93,6 +93,7 @@ noise_time = 4              # the adaptation's time constants (s) and margin
 motion_span = 0.5
 motion_margin = 3
 rest_threshold = 3          # 0: never at rest
+rest_memory = 2.5           # s; 0: the window's smoothing at rest
 
 [[stream]]
 id = 7
@@ -224,6 +225,7 @@ TEST(Config, AFullConfigFillsEveryField) {
     EXPECT_EQ(e.adaptation.motion_span_s, 0.5);
     EXPECT_EQ(e.adaptation.motion_margin, 1.5);
     EXPECT_EQ(e.adaptation.rest_threshold, 3.0);
+    EXPECT_EQ(e.adaptation.rest_memory_s, 2.5);
   }
   {
     const StreamConfig& s = c.streams[1];
@@ -1562,6 +1564,12 @@ name = "a"
 driver = { type = "synthetic", rate_hz = 100 }
 engine = { rest_threshold = -0.5 }
 )", "stream[1].engine.rest_threshold: out of range: must be in [0, 100], got -0.5", 5},
+    {"rest_memory over ten minutes", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+engine = { rest_memory = 601 }
+)", "stream[1].engine.rest_memory: out of range: must be in [0, 600], got 601", 5},
     {"continuity with adapted smoothing", R"([engine]
 window = 32
 continuity = 1

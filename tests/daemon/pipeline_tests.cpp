@@ -621,6 +621,34 @@ TEST(Pipeline, TheBodyRateOfSamplesStampedInClumpsIsOverTheirInterval) {
   EXPECT_GT(checked, 500u);
 }
 
+// A tracker lying still, its noise alternating in sign from sample to sample (so the rest
+// line is straight at every sample, whatever the seed): the daemon reports what the engine
+// does at rest, averaged over seconds by default and not with rest_memory = 0.
+TEST(Pipeline, AStillTrackerIsReportedAtRestAndAveragedOverSeconds) {
+  ScratchDir dir;
+  std::vector<Sample> still;
+  for (int k = 0; k < 600; ++k) {
+    Sample s;
+    s.stream_id = 1;
+    s.sequence = static_cast<std::uint64_t>(k);
+    s.time = k / 100.0;
+    s.orientation = so3::exp((k % 2 == 0 ? 0.002 : -0.002) * Vec3(1.0, -1.0, 0.5));
+    still.push_back(s);
+  }
+  write_imu_log(dir / "in.pflog", still);
+  for (const std::string memory : {"", "rest_memory = 0\n"}) {
+    SCOPED_TRACE(memory.empty() ? "defaults" : memory);
+    const std::string text = "[[stream]]\nid = 1\nname = \"tracker\"\nring_capacity = 4096\n"
+                             "[stream.driver]\ntype = \"replay\"\npath = \"" +
+                             (dir / "in.pflog").string() + "\"\ntiming = \"fast\"\n[stream.engine]\n" + memory +
+                             "\n[[output]]\ndestinations = [\"127.0.0.1:9\"]\n";
+    const StreamStats st = run_to_end(parse_config(text, "/virtual/still.toml"));
+    EXPECT_EQ(st.emitted, still.size());
+    EXPECT_TRUE(st.engine.rotation.at_rest);
+    EXPECT_EQ(st.engine.rotation.rest_averaged, memory.empty());
+  }
+}
+
 // The same receive times: resampled onto a 90 Hz grid, and limited to 100 poses a second. Both
 // place the poses at the times the samples were taken (sampled_clock.hpp), not at their stamps:
 // through knots 1 µs apart the spline's grid poses were radians off, and by the stamps the limit

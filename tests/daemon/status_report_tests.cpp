@@ -199,7 +199,14 @@ TEST(StatusReport, CounterLineAndStatusCarryTheEngineAdaptation) {
             std::string::npos)
       << still[0];
   EXPECT_NE(status_line({s}, {}, 1.0).find(" fc 0.11Hz (adapted, at rest)"), std::string::npos) << status_line({s}, {}, 1.0);
-  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("cutoff_hz":0.11,"at_rest":true})"), std::string::npos) << streams_member({s}, {}, 1.0);
+  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("cutoff_hz":0.11,"at_rest":true,"rest_averaged":false})"), std::string::npos)
+      << streams_member({s}, {}, 1.0);
+  // Averaged over seconds by the rest line (docs/engine.md, "At rest"): said in all three.
+  s.engine.rotation.rest_averaged = true;
+  const auto averaged = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(averaged[0].find("cutoff 0.11 Hz (mu 1e+09), at rest, averaged over seconds"), std::string::npos) << averaged[0];
+  EXPECT_NE(status_line({s}, {}, 1.0).find(" fc 0.11Hz (adapted, at rest, averaged)"), std::string::npos) << status_line({s}, {}, 1.0);
+  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("at_rest":true,"rest_averaged":true})"), std::string::npos) << streams_member({s}, {}, 1.0);
 }
 
 TEST(StatusReport, AFusionStageAddsItsBiasRestDisturbanceAndCounters) {

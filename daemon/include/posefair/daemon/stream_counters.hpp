@@ -40,7 +40,7 @@ struct StreamCounters {
   // The engine's state (FairingWindow::state()): the rate and window it settled on, and what
   // its adaptation measured and chose. Written by the engine thread after each batch.
   struct Channel {
-    std::atomic<bool> adaptive{false}, at_rest{false};
+    std::atomic<bool> adaptive{false}, at_rest{false}, rest_averaged{false};
     std::atomic<double> noise{0.0}, motion{0.0}, smoothing{0.0}, cutoff_hz{0.0};
   };
   std::atomic<double> engine_rate_hz{0.0};
