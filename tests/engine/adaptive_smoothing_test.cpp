@@ -481,6 +481,23 @@ TEST(Adaptation, AStillPoseIsAveragedOverSeconds) {
   }
 }
 
+// `seconds` of a sway at `rate` on two axes (amplitude ax at hz, ay at ratio·hz), each sample
+// turned by a Gaussian rotation of `sigma` per axis.
+Stream two_axis_sway(double rate, double seconds, double hz, double ax, double ay, double ratio, double sigma, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, sigma);
+  Stream s;
+  for (int i = 0; i < static_cast<int>(seconds * rate); ++i) {
+    const double t = i / rate;
+    const double w = 2.0 * std::numbers::pi * hz * t;
+    const Quat q = so3::from_rotation_vector(Vec3(ax * std::sin(w), ay * std::sin(ratio * w + 1.0), 0.0));
+    s.input.time.push_back(t);
+    s.input.orientation.push_back(q * so3::from_rotation_vector(Vec3(noise(rng), noise(rng), noise(rng))));
+    s.truth.push_back(q);
+  }
+  return s;
+}
+
 TEST(Adaptation, ASlowSwayIsNotAveragedIntoLag) {
   // A sway under the noise passes the rest test (the window's slope stays within its noise),
   // but a line with a memory of 1 s would lag behind it: 4–6% more error than the window's
@@ -490,17 +507,7 @@ TEST(Adaptation, ASlowSwayIsNotAveragedIntoLag) {
     SCOPED_TRACE(std::to_string(rate) + " Hz, sway " + std::to_string(hz) + " Hz");
     double on = 0.0, off_error = 0.0;
     for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-      std::mt19937_64 rng(seed);
-      std::normal_distribution<double> noise(0.0, 0.01 / std::sqrt(3.0));
-      Stream s;
-      for (int i = 0; i < static_cast<int>(30.0 * rate); ++i) {
-        const double t = i / rate;
-        const double w = 2.0 * std::numbers::pi * hz * t;
-        const Quat q = so3::from_rotation_vector(Vec3(0.01 * std::sin(w), 0.006 * std::sin(1.37 * w + 1.0), 0.0));
-        s.input.time.push_back(t);
-        s.input.orientation.push_back(q * so3::from_rotation_vector(Vec3(noise(rng), noise(rng), noise(rng))));
-        s.truth.push_back(q);
-      }
+      const Stream s = two_axis_sway(rate, 30.0, hz, 0.01, 0.006, 1.37, 0.01 / std::sqrt(3.0), seed);
       WindowConfig off;
       off.adaptation.rest_memory_s = 0.0;
       on += rms_error_between(s, fair_causal(s.input, WindowConfig{}).poses.orientation, 2.0, 30.0);
@@ -565,17 +572,7 @@ TEST(Adaptation, AVibrationIsNotTakenForRest) {
   // raw.
   for (const auto& [rate, hz] : {std::pair{100.0, 5.0}, std::pair{30.0, 3.0}}) {
     SCOPED_TRACE(std::to_string(rate) + " Hz, vibration " + std::to_string(hz) + " Hz");
-    std::mt19937_64 rng(3);
-    std::normal_distribution<double> noise(0.0, 0.003);
-    Stream s;
-    for (int i = 0; i < static_cast<int>(20.0 * rate); ++i) {
-      const double t = i / rate;
-      const double w = 2.0 * std::numbers::pi * hz * t;
-      const Quat q = so3::from_rotation_vector(Vec3(0.01 * std::sin(w), 0.005 * std::sin(1.3 * w + 1.0), 0.0));
-      s.input.time.push_back(t);
-      s.input.orientation.push_back(q * so3::from_rotation_vector(Vec3(noise(rng), noise(rng), noise(rng))));
-      s.truth.push_back(q);
-    }
+    const Stream s = two_axis_sway(rate, 20.0, hz, 0.01, 0.005, 1.3, 0.003, 3);
     WindowConfig off;
     off.adaptation.rest_threshold = 0.0;
     const double raw = rms_error_between(s, s.input.orientation, 2.0, 20.0);
