@@ -513,9 +513,10 @@ std::size_t FairingWindow::memory_bytes() const {
   bytes += levels_.capacity() * sizeof(EmissionRow);
   for (const EmissionRow& r : levels_) bytes += row_bytes(r);
   bytes += row_bytes(fill_row_) + row_bytes(rot_.fixed) + row_bytes(pos_.fixed);
-  // The builder's band matrix and scratch, and the three estimators' fit, half-span fit and line weights.
+  // The builder's band matrix and scratch, and the three estimators' fit, half-span fit, window
+  // fit and line weights.
   bytes += static_cast<std::size_t>(capacity_) * (static_cast<std::size_t>(config_.order + 1) + 5) * sizeof(double) +
-           static_cast<std::size_t>(capacity_ + 1) * sizeof(Vec3) + 3 * 3 * static_cast<std::size_t>(capacity_) * sizeof(double);
+           static_cast<std::size_t>(capacity_ + 1) * sizeof(Vec3) + 3 * 4 * static_cast<std::size_t>(capacity_) * sizeof(double);
   for (const auto* set : {&factors_r_, &factors_t_}) {
     bytes += set->capacity() * sizeof(BandedCholesky);
     for (const BandedCholesky& f : *set) bytes += static_cast<std::size_t>(f.size() * (f.bandwidth() + 1)) * sizeof(double);

@@ -71,6 +71,7 @@ MotionNoiseEstimator::MotionNoiseEstimator(int capacity, int order)
       capacity_(capacity),
       fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
       short_fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
+      window_fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
       line_(static_cast<std::size_t>(std::max(1, capacity)), 0.0) {}
 
 void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& settings, int window) {
@@ -94,6 +95,13 @@ void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& s
   double sxx = 0.0;
   for (int i = 0; i < line_span_; ++i) sxx += (i - cl) * (i - cl);
   line_noise_gain_ = difference_weights(line_span_, [&](int i) { return (i - cl) / sxx; }, line_);
+  // The slow part's fit over the window: its m-th derivative has (W/span)^(2m+1) times less noise
+  // (32 times at m = 2), so it tells a slow motion from none where the fit above cannot. Not where
+  // the window's minimum of samples stretches it past twice the fit's span (under 16 Hz with the
+  // defaults): there it averages away motion the fit still sees (TUM's handheld camera at 10 Hz:
+  // +2.6% and +3.2% error with it), as a longer fit span did (docs/engine.md).
+  const bool window_fit = line_span_ >= m + 1 && line_span_ <= 2.0 * settings.motion_span_s * rate_hz + 1.0;
+  window_fit_noise_gain_ = window_fit ? derivative_fit_weights(line_span_, m, window_fit_) : 0.0;
 }
 
 void MotionNoiseEstimator::update_noise(double length, double dt) {
@@ -142,13 +150,24 @@ double MotionNoiseEstimator::newest_half_fit_of_medians(std::span<const Vec3> ze
   return sum.squaredNorm() / 3.0;
 }
 
+double MotionNoiseEstimator::motion_floor(double fit_noise) const {
+  if (!settings_.motion_floor) return 0.0;
+  // Where the window's fit is in (on a full window), motion it measures below the fit's noise is
+  // taken as it measures it, but never below its own noise.
+  if (window_fit_noise_gain_ > 0.0 && window_ready_) {
+    const double window_noise = noise_var_ * window_fit_noise_gain_;
+    return std::min(fit_noise, std::max(window_noise, window_mean_square_ - window_noise));
+  }
+  return fit_noise;
+}
+
 bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
   const int n1 = static_cast<int>(zeta.size());  // differences available
   const int k = order_ + 2;
   if (!(dt > 0.0)) return false;
   const bool was_ready = ready();
   // The rest test's line is taken on a full window only: after a restart its average starts afresh.
-  if (n1 < line_span_ - 1) line_ready_ = false;
+  if (n1 < line_span_ - 1) line_ready_ = window_ready_ = false;
   bool refreshed = false;
   if (n1 >= k - 1 + 1) {
     // D^kθ at the newest = D^{k−1} of the newest k differences.
@@ -210,7 +229,15 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
       }
       onset_over_ = over;
       onset_last_ = sample;
-      if (settings_.motion_floor && settings_.rest_threshold > 0.0 && n1 >= line_span_ - 1) {
+      const bool full = n1 >= line_span_ - 1;
+      if (settings_.motion_floor && window_fit_noise_gain_ > 0.0 && full) {
+        const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return window_fit_[static_cast<std::size_t>(j)]; },
+                                           zeta.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
+        const double slow = v.squaredNorm() / 3.0;
+        window_mean_square_ = window_ready_ ? window_mean_square_ + alpha * (slow - window_mean_square_) : slow;
+        window_ready_ = true;
+      }
+      if (settings_.motion_floor && settings_.rest_threshold > 0.0 && full) {
         const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return line_[static_cast<std::size_t>(j)]; },
                                            zeta.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
         const double slope = v.squaredNorm() / 3.0;
@@ -230,7 +257,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
     if (at_rest_)
       motion_var_ = mean_square_ < threshold * fit_noise ? 0.0 : mean_square_ - fit_noise;
     else
-      motion_var_ = std::max(settings_.motion_floor ? fit_noise : 0.0, mean_square_ - fit_noise);
+      motion_var_ = std::max(motion_floor(fit_noise), mean_square_ - fit_noise);
     // The fast part counts where it stands clear of the noise its fit lets through.
     if (short_span_ > 0 && short_mean_square_ > kFastMotionFactor * short_noise)
       motion_var_ = std::max(motion_var_, short_mean_square_ - short_noise);

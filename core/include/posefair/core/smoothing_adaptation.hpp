@@ -12,8 +12,10 @@
 //     the centre of a short span), squared, averaged over a short time, minus the noise the
 //     fit lets through (σ² times the sum of its squared weights, known exactly). Motion
 //     below that noise cannot be told from none, so the estimate never goes below it: a
-//     stream that only seems still is not smoothed without limit. A fit over half the span
-//     adds the motion's fast part (a shake) where it stands clear of its own noise.
+//     stream that only seems still is not smoothed without limit. The same fit over the whole
+//     window tells a slow motion from none much more closely, and lowers that floor to what it
+//     sees. A fit over half the span adds the motion's fast part (a shake) where it stands clear
+//     of its own noise.
 //   rest: a stream whose slope over the whole window is within its noise too is at rest (a
 //     tracker put down, a head held still). Then the floor is dropped, and the motion counts
 //     only where the fit sees it stand out of its noise: a still stream is smoothed as hard
@@ -115,6 +117,9 @@ class MotionNoiseEstimator {
 
  private:
   void update_noise(double length, double dt);
+  // The least motion assumed while moving: the noise the fit lets through, or less where the
+  // window's fit sees the motion is smaller.
+  double motion_floor(double fit_noise) const;
   // The fit over the newest half span of the samples' running median of three, its mean square.
   double newest_half_fit_of_medians(std::span<const Vec3> zeta) const;
 
@@ -140,6 +145,12 @@ class MotionNoiseEstimator {
   bool motion_ready_ = false;
   double motion_pending_s_ = 0.0;  // stream time since the fit was last taken
   double motion_var_ = 0.0;
+  // The motion's slow part: the same fit over the whole window (line_span_ samples; none where
+  // that spans more than twice motion_span_s), its mean square, and its noise gain.
+  std::vector<double> window_fit_;
+  double window_fit_noise_gain_ = 0.0;
+  double window_mean_square_ = 0.0;
+  bool window_ready_ = false;
   // Rest: the slope of a line through the newest line_span_ samples (weights on their
   // differences, as fit_), its mean square, and Σ of its squared weights on θ.
   int line_span_ = 0;
