@@ -3,6 +3,7 @@
 #include "posefair/core/combinatorics.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <Eigen/Cholesky>
@@ -10,17 +11,26 @@
 namespace posefair {
 namespace {
 
+// C(k, j) for the moments' orders, k < 5.
+constexpr std::array<std::array<double, 5>, 5> kBinomials = [] {
+  std::array<std::array<double, 5>, 5> c{};
+  for (int k = 0; k < 5; ++k)
+    for (int j = 0; j <= k; ++j) c[static_cast<std::size_t>(k)][static_cast<std::size_t>(j)] = binomial(k, j);
+  return c;
+}();
+
 // Σ w·(a + dt)^k from Σ w·a^j, j ≤ k (the binomial expansion), in place from the top down.
 template <class T, std::size_t N>
 void age_by(std::array<T, N>& sums, double dt) {
-  for (int k = static_cast<int>(N) - 1; k >= 1; --k) {
-    T shifted = sums[static_cast<std::size_t>(k)];
+  static_assert(N <= 5);
+  for (std::size_t k = N - 1; k >= 1; --k) {
+    T shifted = sums[k];
     double power = 1.0;
-    for (int j = k - 1; j >= 0; --j) {
+    for (std::size_t j = k; j-- > 0;) {
       power *= dt;
-      shifted += binomial(k, j) * power * sums[static_cast<std::size_t>(j)];
+      shifted += kBinomials[k][j] * power * sums[j];
     }
-    sums[static_cast<std::size_t>(k)] = shifted;
+    sums[k] = shifted;
   }
 }
 

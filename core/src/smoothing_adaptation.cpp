@@ -97,7 +97,7 @@ void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& s
   line_noise_gain_ = difference_weights(line_span_, [&](int i) { return (i - cl) / sxx; }, line_);
   // The slow part's fit over the window: its m-th derivative has (W/span)^(2m+1) times less noise
   // (32 times at m = 2), so it tells a slow motion from none where the fit above cannot. Not where
-  // the window's minimum of samples stretches it past twice the fit's span (under 16 Hz with the
+  // the window's minimum of samples stretches it past twice the fit's span (under 14 Hz with the
   // defaults): there it averages away motion the fit still sees (TUM's handheld camera at 10 Hz:
   // +2.6% and +3.2% error with it), as a longer fit span did (docs/engine.md).
   const bool window_fit = line_span_ >= m + 1 && line_span_ <= 2.0 * settings.motion_span_s * rate_hz + 1.0;
