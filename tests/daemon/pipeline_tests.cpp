@@ -621,9 +621,9 @@ TEST(Pipeline, TheBodyRateOfSamplesStampedInClumpsIsOverTheirInterval) {
   EXPECT_GT(checked, 500u);
 }
 
-// A tracker lying still, its noise alternating in sign from sample to sample (so the rest
-// line is straight at every sample, whatever the seed): the daemon reports what the engine
-// does at rest, averaged over seconds by default and not with rest_memory = 0.
+// A tracker lying still, its noise alternating in sign from sample to sample (no random draw
+// decides whether the rest line is straight at the last sample: it is): the daemon reports
+// what the engine does at rest, averaged over seconds by default and not with rest_memory = 0.
 TEST(Pipeline, AStillTrackerIsReportedAtRestAndAveragedOverSeconds) {
   ScratchDir dir;
   std::vector<Sample> still;
