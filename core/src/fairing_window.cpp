@@ -123,6 +123,8 @@ void validate(const WindowConfig& c) {
     bad(S::Adaptation, "the rest memory must be in [0, 600] seconds (0: off)");
   if (!(a.motion_margin > 0.0 && a.motion_margin <= kMaxMotionMargin))
     bad(S::Adaptation, "the adaptation's motion margin must be in (0, 100]");
+  if (c.outlier_threshold && !(*c.outlier_threshold >= 0.0 && *c.outlier_threshold <= kMaxOutlierThreshold))
+    bad(S::OutlierThreshold, "outlier_threshold must be in [0, 1000] (0: off), got " + std::to_string(*c.outlier_threshold));
   if (!(c.continuity >= 0.0) || !std::isfinite(c.continuity)) bad(S::Continuity, "continuity must be finite and >= 0");
   if (c.continuity > 0.0) {
     if (c.window == 0) bad(S::Continuity, "continuity needs a window in samples (its stability is checked for that window)");
@@ -157,6 +159,11 @@ double cutoff_for_smoothing(double mu, double rate_hz, int order) {
   return rate_hz * std::asin(std::min(1.0, 0.5 * s)) / std::numbers::pi;
 }
 
+double outlier_threshold(const WindowConfig& config) {
+  if (config.outlier_threshold) return *config.outlier_threshold;
+  return config.lag > 0 ? kDefaultOutlierThreshold : 0.0;
+}
+
 FairingWindow::Channel::Channel(int capacity, int order) : fixed(make_emission_row(capacity)), estimator(capacity, order) {}
 
 FairingWindow::FairingWindow(const WindowConfig& config)
@@ -169,6 +176,8 @@ FairingWindow::FairingWindow(const WindowConfig& config)
       fill_row_(make_emission_row(capacity_)),
       rot_(capacity_, config.order),
       pos_(capacity_, config.order),
+      rot_guard_(outlier_threshold(config), 0.5),  // log gives half the rotation angle
+      pos_guard_(outlier_threshold(config), 1.0),
       gyro_(config.gyro),
       aided_estimator_(capacity_, config.order) {
   const auto w = static_cast<std::size_t>(capacity_);
@@ -181,6 +190,7 @@ FairingWindow::FairingWindow(const WindowConfig& config)
   residual_.resize(w);
   est_.resize(w);
   window_clamped_.assign(w, 0);
+  held_.assign(w, 0);
   c_.resize(w);
   dzp_.resize(w);
   cp_.resize(w);
@@ -508,7 +518,7 @@ std::size_t FairingWindow::memory_bytes() const {
   bytes += (zeta_.capacity() + residual_.capacity() + est_.capacity() + c_.capacity() + dzp_.capacity() + cp_.capacity()) * sizeof(Vec3);
   bytes += (zp_.capacity() + xp_.capacity() + yp_.capacity() + e_.capacity() + u_.capacity() + w_scratch_.capacity() +
             rhs_.capacity()) * sizeof(Vec3);
-  bytes += (diag_.capacity() + sampled_step_.capacity() + stamp_.capacity()) * sizeof(double) + window_clamped_.capacity();
+  bytes += (diag_.capacity() + sampled_step_.capacity() + stamp_.capacity()) * sizeof(double) + window_clamped_.capacity() + held_.capacity();
   auto row_bytes = [](const EmissionRow& r) { return (r.zeta.capacity() + r.c.capacity()) * sizeof(double); };
   bytes += levels_.capacity() * sizeof(EmissionRow);
   for (const EmissionRow& r : levels_) bytes += row_bytes(r);
@@ -529,7 +539,10 @@ int FairingWindow::first_unemitted() const { return std::max(0, n_ - config_.lag
 FairedPose FairingWindow::emit(int index) {
   const auto k = static_cast<std::size_t>(index);
   Quat q = config_.solver == WindowSolver::Linear ? Quat((z_[k] * so3::exp(est_[k])).normalized()) : x_[k];
-  bool clamped = project_rotation(z_[k], q, config_.epsilon_r);
+  const Sample& s = samples_[k];
+  // The bound is on the measurement, a held outlier's too (z_ holds its prediction).
+  const char held = held_[k];
+  bool clamped = project_rotation((held & kHeldRotation) ? so3::aligned_to(s.orientation, z_[k]) : z_[k], q, config_.epsilon_r);
   // The stream stays hemisphere-continuous across window restarts too.
   if (have_emitted_) q = so3::aligned_to(q, last_emitted_);
   last_emitted_ = q;
@@ -537,7 +550,7 @@ FairedPose FairingWindow::emit(int index) {
   // The linear solver's continuity term needs the emitted correction log(z⁻¹ y).
   if (config_.solver == WindowSolver::Linear && config_.continuity > 0.0) c_[k] = so3::log(z_[k].conjugate() * q);
   Vec3 p = xp_[k];
-  if (positions_) clamped = project_position(zp_[k], p, config_.epsilon_t) || clamped;
+  if (positions_) clamped = project_position((held & kHeldPosition) ? s.position : zp_[k], p, config_.epsilon_t) || clamped;
   if (positions_ && config_.solver == WindowSolver::Linear && config_.continuity > 0.0) cp_[k] = p - zp_[k];
   // With the window policy the projection may already have happened inside the solve.
   clamped = clamped || window_clamped_[k];
@@ -545,7 +558,6 @@ FairedPose FairingWindow::emit(int index) {
   y_[k] = q;
   yp_[k] = p;
   ++counters_.emitted;
-  const Sample& s = samples_[k];
   FairedPose out;
   out.stream_id = s.stream_id;
   out.sequence = s.sequence;
@@ -554,7 +566,7 @@ FairedPose FairingWindow::emit(int index) {
   out.position = positions_ ? p : Vec3::Zero();
   out.measured = s.orientation;
   out.measured_position = s.position;
-  out.flags = s.flags | (clamped ? kClamped : 0u);
+  out.flags = s.flags | (clamped ? kClamped : 0u) | (held != 0 ? kHeld : 0u);
   out.step = sampled_step_[k];
   return out;
 }
@@ -594,7 +606,22 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   const bool had_last = have_time_;
   last_time_ = s.time;
   have_time_ = true;
-  append(s);
+  Quat held_z;
+  Vec3 held_p;
+  char held = 0;
+  if (hold_outliers(s, dt > 0.0 ? gate_.sampled_step() : 0.0, held_z, held_p, held)) {
+    Sample h = s;
+    h.orientation = held_z;
+    h.position = held_p;
+    append(h);
+    const auto k = static_cast<std::size_t>(n_ - 1);
+    samples_[k].orientation = s.orientation;  // emitted as measured, and bounded by it
+    samples_[k].position = s.position;
+    held_[k] = held;
+    ++counters_.held;
+  } else {
+    append(s);
+  }
   if (!prepared_) note_interval(dt);
   const int k = n_ - 1 - config_.lag;
   if (config_.solver == WindowSolver::Linear) {
@@ -628,6 +655,7 @@ void FairingWindow::slide(int count) {
   drop(sampled_step_);
   drop(stamp_);
   drop(z_);
+  drop(held_);
   if (config_.solver == WindowSolver::Linear) {
     drop(zeta_);
     drop(residual_);
@@ -645,6 +673,47 @@ void FairingWindow::slide(int count) {
     drop(yp_);
   }
   n_ -= count;
+}
+
+// A lone outlier (outlier_guard.hpp) is held at the prediction: z and p, the values the
+// window takes instead. A held sample that the next one shows to be a motion's start is taken
+// back into the window as measured. step: how long after the window's newest sample s was
+// taken (0: it starts a window).
+bool FairingWindow::hold_outliers(const Sample& s, double step, Quat& z, Vec3& p, char& held) {
+  using Verdict = OutlierGuard::Verdict;
+  held = 0;
+  if (n_ == 0 || step <= 0.0) {
+    rot_guard_.restart();
+    pos_guard_.restart();
+    return false;
+  }
+  const auto last = static_cast<std::size_t>(n_ - 1);
+  const bool linear = config_.solver == WindowSolver::Linear;
+  z = so3::aligned_to(s.orientation, z_[last]);
+  Vec3 increment = so3::log(z_[last].conjugate() * z);
+  const Verdict rotation = rot_guard_.check(step, increment);
+  if (rotation == Verdict::Hold) z = (z_[last] * so3::exp(increment)).normalized();
+  if (rotation == Verdict::Release) {
+    z_[last] = so3::aligned_to(samples_[last].orientation, last > 0 ? z_[last - 1] : z_[last]);
+    if (linear && last > 0) zeta_[last - 1] = so3::log(z_[last - 1].conjugate() * z_[last]);
+  }
+  p = s.position;
+  Verdict position = Verdict::Take;
+  if (positions_ && s.has_position()) {
+    Vec3 dp = s.position - zp_[last];
+    position = pos_guard_.check(step, dp);
+    if (position == Verdict::Hold) p = zp_[last] + dp;
+    if (position == Verdict::Release) {
+      zp_[last] = samples_[last].position;
+      if (linear && last > 0) dzp_[last - 1] = zp_[last] - zp_[last - 1];
+    }
+  }
+  // Not yet emitted (a lag): a released channel is emitted as measured.
+  if (rotation == Verdict::Release) held_[last] &= ~kHeldRotation;
+  if (position == Verdict::Release) held_[last] &= ~kHeldPosition;
+  if (rotation == Verdict::Release || position == Verdict::Release) ++counters_.released;
+  held = (rotation == Verdict::Hold ? kHeldRotation : 0) | (position == Verdict::Hold ? kHeldPosition : 0);
+  return held != 0;
 }
 
 bool FairingWindow::gyro_aided(const Sample& s) const {
@@ -672,6 +741,7 @@ void FairingWindow::append(const Sample& s) {
   stamp_[k] = s.time;
   sampled_step_[k] = gate_.sampled_step();
   window_clamped_[k] = 0;
+  held_[k] = 0;
   Quat z = s.orientation;
   if (n_ == 0) {
     if (z.w() < 0.0) z.coeffs() = -z.coeffs();

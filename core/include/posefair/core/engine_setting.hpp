@@ -27,6 +27,7 @@ enum class EngineSetting {
   Bound,
   GapThreshold,
   UnitTolerance,
+  OutlierThreshold,
 };
 
 // What validate(WindowConfig), FairingWindow and SampleGate throw for a refused setting. A

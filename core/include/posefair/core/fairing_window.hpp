@@ -32,6 +32,7 @@
 #include "posefair/core/banded_cholesky.hpp"
 #include "posefair/core/fairing_operators.hpp"
 #include "posefair/core/gyro_aiding.hpp"
+#include "posefair/core/outlier_guard.hpp"
 #include "posefair/core/rest_line.hpp"
 #include "posefair/core/sample.hpp"
 #include "posefair/core/sample_gate.hpp"
@@ -70,11 +71,21 @@ struct WindowConfig {
   double epsilon_t = std::numeric_limits<double>::infinity();  // position units
   BoundPolicy bound = BoundPolicy::Sample;  // Window needs an iterative solver
   GateConfig gate;
+  // A lone sample further from the prediction of the ones before it than this many times the
+  // median of that distance, right after an ordinary one, is held at the prediction
+  // (outlier_guard.hpp); 0: off. Unset: kDefaultOutlierThreshold with a lag, off without one
+  // (at lag 0 an outlier and a sudden motion's first sample look alike until it is emitted).
+  std::optional<double> outlier_threshold;
   // Samples with a gyroscope reading (kHasGyro) put the smoothness on the orientation's angular
   // velocity minus the gyro's (gyro_aiding.hpp); linear solver, no horizon. Up to
   // kMaxBridgedGyroReadings missing readings in a row are bridged; more restart the window.
   GyroAidingSettings gyro;
 };
+
+// The outlier guard's threshold where the window has a lag and none is given.
+inline constexpr double kDefaultOutlierThreshold = 8.0;
+// The threshold in use: given, or the default (kDefaultOutlierThreshold with a lag, 0 without).
+double outlier_threshold(const WindowConfig& config);
 
 // Largest accepted smoothing weight μ (see validate()).
 inline constexpr double kMaxSmoothing = 1e10;
@@ -100,6 +111,8 @@ struct WindowCounters {
   std::uint64_t restarts = 0;   // windows restarted after a gap, a change of rate, or for samples with/without positions or gyro
   std::uint64_t rate_changes = 0;  // of those, for a change of the measured rate (the window restarted at the new one)
   std::uint64_t gyro_bridged = 0;  // readings missing from a gyro-aided window, bridged without a restart
+  std::uint64_t held = 0;          // lone outliers held at the prediction (rotation, position or both)
+  std::uint64_t released = 0;      // of those, taken back: the next sample showed a motion starting
 };
 
 // What the engine is doing now: the rate and window it settled on and, per channel, what the
@@ -163,6 +176,9 @@ class FairingWindow {
     bool rest_averaged = false;
   };
 
+  // held_'s bits: which channel of a sample holds the prediction.
+  static constexpr char kHeldRotation = 1, kHeldPosition = 2;
+  bool hold_outliers(const Sample& s, double step, Quat& z, Vec3& p, char& held);
   void append(const Sample& s);
   bool gyro_aided(const Sample& s) const;
   // What the rotation rows apply to: the measured increments ζ, or with a gyro their residual.
@@ -227,6 +243,7 @@ class FairingWindow {
   int level_count_ = 0;
   EmissionRow fill_row_;             // scratch: the row of a window still filling
   Channel rot_, pos_;
+  OutlierGuard rot_guard_, pos_guard_;
   GyroAiding gyro_;
   // The rotation's adaptation while gyro-aided: the residual is slow, so its motion is fitted
   // over the whole window (a shorter fit passes so much noise that it would pass for motion).
@@ -249,6 +266,7 @@ class FairingWindow {
   SlidingArray<Vec3> dzp_;         // p_{j+1} − p_j (Linear)
   SlidingArray<Vec3> cp_;          // y_p,i − z_p,i of emitted samples (Linear)
   SlidingArray<char> window_clamped_;  // the window bound moved this sample during a solve
+  SlidingArray<char> held_;        // an outlier held (kHeldRotation, kHeldPosition): z_/zp_ hold the prediction, samples_ the measurement
   SlidingArray<Quat> y_;           // what was emitted (valid for emitted indices)
   SlidingArray<Vec3> zp_, xp_, yp_;
   // Scratch.

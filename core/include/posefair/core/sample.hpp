@@ -19,6 +19,7 @@ enum SampleFlags : std::uint32_t {
   kHasAccel = 1u << 5,       // accel, m/s^2 (specific force: +g upwards at rest)
   kHasMag = 1u << 6,         // mag, microtesla
   kNoOrientation = 1u << 7,  // raw inertial sample only
+  kHeld = 1u << 8,  // FairedPose only: its measurement was a lone outlier, held at the prediction (outlier_guard.hpp)
 };
 
 struct Sample {

@@ -1,0 +1,80 @@
+#pragma once
+// A lone outlier: one sample far from where the samples before it were going (an optical
+// tracker's reflection taken for a marker for one frame, a value corrupted but still parsed).
+// Smoothing cannot hide one: the window spreads it over its neighbours, and it breaks the rest
+// test, so a still stream with 1% of its samples 0.2 rad off gets 75% more error than a fixed
+// 1 Hz cutoff (docs/engine.md, "Outliers").
+//
+// The guard predicts each sample from a line through the few before it (least squares on the
+// sum of their increments against their real times), and tracks the median of how far samples
+// land from that prediction. A sample further than `threshold` times that median is held at the
+// prediction if the sample before it was ordinary (within twice the median). A sudden motion
+// mostly builds up over a sample or two, which puts the sample before it off the line already;
+// and the sample after a held one tells an outlier from a motion's start or a jump that stays:
+// after an outlier it lands near the line, after a start nearer the held measurement than the
+// line, and the held sample is released (taken back into the window as measured, and emitted so
+// if the window's lag has not emitted it yet). So with a lag the guard costs a sudden motion
+// nothing; with none, the held first sample of a motion that starts at once is emitted at the
+// prediction, which is why the engine leaves it off by default at lag 0 (fairing_window.hpp).
+// The median is the stream's own (its noise and how well its motion is predicted), so the
+// threshold needs no units; below a small floor nothing is held (a still, quantised stream whose
+// median is zero would otherwise hold every least bit it moves).
+// One guard per channel: rotation (increments log(z_j⁻¹ z_{j+1})) and position (p_{j+1} − p_j).
+// Fixed size, no allocation.
+#include <array>
+
+#include "posefair/core/so3.hpp"
+
+namespace posefair {
+
+// Points of the line the prediction comes from (the sample before plus its predecessors).
+inline constexpr int kOutlierFitPoints = 6;
+// Distances before the median is trusted: nothing is held before (a guard that started low
+// would hold real samples; it starts at the largest of these and comes down).
+inline constexpr int kOutlierWarmUp = 20;
+// Below this distance from the prediction (rad of rotation angle, or position units) nothing is
+// held: under any tracker's noise, and smaller than any outlier worth a held sample.
+inline constexpr double kOutlierFloor = 1e-4;
+// The largest threshold accepted (multiples of the median).
+inline constexpr double kMaxOutlierThreshold = 1000.0;
+
+class OutlierGuard {
+ public:
+  // threshold: multiples of the median of the prediction's error (WindowConfig's
+  // outlier_threshold); 0 holds nothing.
+  // scale: the increment's units per unit of distance (rotation: log gives half the angle, so
+  // 0.5; position: 1).
+  OutlierGuard(double threshold, double scale);
+
+  enum class Verdict {
+    Take,
+    Hold,     // a lone outlier: increment is replaced by the prediction
+    Release,  // the sample before was held, but this one says a motion started: it lands nearer
+              // the held measurement than the line. Take the held sample back as measured;
+              // increment is made relative to it.
+  };
+  // The sample `step` seconds after the previous one, `increment` from it (from the held
+  // prediction, if the previous sample was held).
+  Verdict check(double step, Vec3& increment);
+  // A new window: the line starts afresh (the median, the stream's own, carries on).
+  void restart() {
+    count_ = 0;
+    ordinary_before_ = held_before_ = false;
+  }
+
+ private:
+  double threshold_;
+  double scale_;
+  // The newest kOutlierFitPoints − 1 steps and increments, a ring; count_ of them held.
+  std::array<double, kOutlierFitPoints - 1> step_{};
+  std::array<Vec3, kOutlierFitPoints - 1> increment_{};
+  int head_ = 0;
+  int count_ = 0;
+  double log_median_ = 0.0;
+  int seen_ = 0;
+  bool ordinary_before_ = false;  // the sample before landed within twice the median
+  bool held_before_ = false;      // the sample before was held; held_offset_: its measurement from the prediction
+  Vec3 held_offset_ = Vec3::Zero();
+};
+
+}  // namespace posefair

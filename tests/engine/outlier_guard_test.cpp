@@ -1,0 +1,294 @@
+// Lone outliers (core/include/posefair/core/outlier_guard.hpp): the guard on its own (what it
+// holds, what it takes, what it releases), and in the engine (on with a lag, off without one,
+// the ε bound still on the measurement, positions as well as rotations).
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "engine_test_support.hpp"
+#include "posefair/core/engine_setting.hpp"
+#include "posefair/core/fairing_window.hpp"
+#include "posefair/core/outlier_guard.hpp"
+#include "posefair/core/so3.hpp"
+
+namespace posefair {
+namespace {
+
+using Verdict = OutlierGuard::Verdict;
+
+// Feeds the guard the points x (steps dt) as the engine does: each increment from the value the
+// window kept for the point before (the prediction where that was held, the measurement where it
+// was released). Returns the verdicts.
+std::vector<Verdict> feed(OutlierGuard& guard, const std::vector<Vec3>& x, double dt) {
+  std::vector<Verdict> verdicts;
+  Vec3 kept = x[0];
+  for (std::size_t i = 1; i < x.size(); ++i) {
+    Vec3 increment = x[i] - kept;
+    const Verdict v = guard.check(dt, increment);
+    verdicts.push_back(v);
+    if (v == Verdict::Release) kept = x[i - 1];
+    kept += increment;
+    if (v != Verdict::Hold) EXPECT_LT((kept - x[i]).norm(), 1e-12) << i;
+  }
+  return verdicts;
+}
+
+// A line in three dimensions with Gaussian noise σ, at 100 Hz.
+std::vector<Vec3> noisy_line(std::size_t n, double sigma, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, sigma);
+  std::vector<Vec3> x;
+  for (std::size_t i = 0; i < n; ++i)
+    x.push_back(Vec3(0.3, -0.1, 0.05) * (static_cast<double>(i) * 0.01) + Vec3(noise(rng), noise(rng), noise(rng)));
+  return x;
+}
+
+std::size_t count(const std::vector<Verdict>& v, Verdict which) {
+  return static_cast<std::size_t>(std::count(v.begin(), v.end(), which));
+}
+
+TEST(OutlierGuard, HoldsALoneOutlierAtThePredictionAndTakesTheSampleAfterIt) {
+  std::vector<Vec3> x = noisy_line(400, 0.001, 1);
+  x[300] += Vec3(0.03, 0.0, -0.02);  // 36 σ off
+  OutlierGuard guard(kDefaultOutlierThreshold, 1.0);
+  Vec3 kept = x[0];
+  for (std::size_t i = 1; i < x.size(); ++i) {
+    Vec3 increment = x[i] - kept;
+    const Verdict v = guard.check(0.01, increment);
+    kept += increment;
+    if (i == 300) {
+      EXPECT_EQ(v, Verdict::Hold);
+      // Held on the line: within a few σ of where the samples were going, not at the outlier.
+      EXPECT_LT((kept - Vec3(0.3, -0.1, 0.05) * 3.0).norm(), 0.005);
+    } else {
+      EXPECT_EQ(v, Verdict::Take) << i;  // noise alone, and the sample after the outlier
+    }
+  }
+}
+
+TEST(OutlierGuard, NothingIsHeldUnderNoiseAlone) {
+  // Ten thousand samples of Gaussian noise on a line, at several sizes: the threshold sits at
+  // about 17 σ of each component (8 times the median of the prediction's error).
+  for (const double sigma : {1e-3, 0.01, 0.1}) {
+    OutlierGuard guard(kDefaultOutlierThreshold, 1.0);
+    const auto v = feed(guard, noisy_line(10000, sigma, 2), 0.01);
+    EXPECT_EQ(count(v, Verdict::Take), v.size()) << sigma;
+  }
+}
+
+TEST(OutlierGuard, AJumpThatStaysIsTakenBackWithTheSampleAfterIt) {
+  // A jump (a relocalised SLAM estimate, a motion that starts at once) is held for one sample,
+  // then released: the next sample lands nearer the held measurement than the line.
+  std::vector<Vec3> x = noisy_line(400, 0.001, 3);
+  for (std::size_t i = 300; i < x.size(); ++i) x[i] += Vec3(0.0, 0.05, 0.0);
+  OutlierGuard guard(kDefaultOutlierThreshold, 1.0);
+  const auto v = feed(guard, x, 0.01);
+  EXPECT_EQ(v[298], Verdict::Take);
+  EXPECT_EQ(v[299], Verdict::Hold);  // x[300]
+  EXPECT_EQ(v[300], Verdict::Release);
+  EXPECT_EQ(count(v, Verdict::Hold), 1u);
+  EXPECT_EQ(count(v, Verdict::Release), 1u);
+}
+
+TEST(OutlierGuard, ASecondFarSampleInARowIsNeverHeld) {
+  // Two outliers in a row: the first is held; the second lands far from the line and nearer the
+  // first than the line, so the first is released and the second taken. Only a sample after an
+  // ordinary one is held.
+  std::vector<Vec3> x = noisy_line(400, 0.001, 4);
+  x[300] += Vec3(0.05, 0.0, 0.0);
+  x[301] += Vec3(0.05, 0.0, 0.0);
+  OutlierGuard guard(kDefaultOutlierThreshold, 1.0);
+  const auto v = feed(guard, x, 0.01);
+  EXPECT_EQ(v[299], Verdict::Hold);
+  EXPECT_EQ(v[300], Verdict::Release);
+  EXPECT_EQ(count(v, Verdict::Hold), 1u);
+}
+
+TEST(OutlierGuard, HoldsNothingWhileWarmingUpOrOff) {
+  std::vector<Vec3> x = noisy_line(400, 0.001, 5);
+  x[10] += Vec3(0.05, 0.0, 0.0);   // before the median is trusted
+  x[300] += Vec3(0.05, 0.0, 0.0);
+  OutlierGuard guard(kDefaultOutlierThreshold, 1.0);
+  auto v = feed(guard, x, 0.01);
+  EXPECT_EQ(v[9], Verdict::Take);
+  EXPECT_EQ(v[299], Verdict::Hold);
+  OutlierGuard off(0.0, 1.0);
+  v = feed(off, x, 0.01);
+  EXPECT_EQ(count(v, Verdict::Take), v.size());
+}
+
+TEST(OutlierGuard, AQuantisedStillStreamHoldsNothing) {
+  // Still, and quantised: its prediction error is zero nearly always, so the percentile is zero;
+  // a least bit it moves now and then is under the floor, not an outlier.
+  std::vector<Vec3> x(2000, Vec3::Zero());
+  for (std::size_t i = 100; i < x.size(); i += 97) x[i] = Vec3(3e-5, 0.0, 0.0);
+  OutlierGuard guard(kDefaultOutlierThreshold, 1.0);
+  const auto v = feed(guard, x, 0.01);
+  EXPECT_EQ(count(v, Verdict::Take), v.size());
+}
+
+// A still orientation (and position) at 100 Hz with noise, 1% of its samples thrown off.
+struct StillWithOutliers {
+  std::vector<Sample> samples;
+  std::vector<std::size_t> outliers;
+};
+StillWithOutliers still_with_outliers(bool with_position, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  StillWithOutliers s;
+  for (std::size_t i = 0; i < 2000; ++i) {
+    Sample x;
+    x.time = static_cast<double>(i) * 0.01;
+    Vec3 r(noise(rng), noise(rng), noise(rng));
+    Vec3 p(noise(rng), noise(rng), noise(rng));
+    if (i > 50 && u(rng) < 0.01) {
+      s.outliers.push_back(i);
+      r += Vec3(0.1, -0.1, 0.05);
+      p += Vec3(-0.1, 0.05, 0.1);
+    }
+    x.orientation = so3::from_rotation_vector(r);
+    if (with_position) {
+      x.position = p;
+      x.flags |= kHasPosition;
+    }
+    s.samples.push_back(x);
+  }
+  return s;
+}
+
+double rotation_rms(const std::vector<FairedPose>& out) {
+  double sum = 0.0;
+  for (const FairedPose& p : out) sum += std::pow(so3::rotation_angle(p.orientation, Quat::Identity()), 2);
+  return std::sqrt(sum / static_cast<double>(out.size()));
+}
+
+double position_rms(const std::vector<FairedPose>& out) {
+  double sum = 0.0;
+  for (const FairedPose& p : out) sum += p.position.squaredNorm();
+  return std::sqrt(sum / static_cast<double>(out.size()));
+}
+
+TEST(OutlierGuardInTheEngine, OnByDefaultWithALagOnlyAndAsGiven) {
+  WindowConfig c;
+  EXPECT_EQ(outlier_threshold(c), 0.0);
+  c.lag = 1;
+  EXPECT_EQ(outlier_threshold(c), kDefaultOutlierThreshold);
+  c.outlier_threshold = 0.0;
+  EXPECT_EQ(outlier_threshold(c), 0.0);
+  c.lag = 0;
+  c.outlier_threshold = 8.0;
+  EXPECT_EQ(outlier_threshold(c), 8.0);
+  c.outlier_threshold = -1.0;
+  EXPECT_THROW(validate(c), InvalidEngineSetting);
+}
+
+TEST(OutlierGuardInTheEngine, WithALagAStillStreamsOutliersAreHeldAndFlagged) {
+  const StillWithOutliers in = still_with_outliers(true, 6);
+  ASSERT_GE(in.outliers.size(), 10u);
+  WindowConfig on;
+  on.lag = 1;
+  WindowConfig off = on;
+  off.outlier_threshold = 0.0;
+  FairingWindow w(on);
+  const auto guarded = run(w, in.samples);
+  const auto plain = run(off, in.samples);
+  ASSERT_EQ(guarded.size(), in.samples.size());
+  // Nine in ten outliers held (one is not when the sample before it was not ordinary, about one
+  // in twenty), each flagged on its pose, which still reports what was measured; nothing else.
+  EXPECT_GE(w.counters().held, in.outliers.size() * 9 / 10);
+  EXPECT_LE(w.counters().released, 2u);  // two outliers in a row: the first is released
+  std::size_t flagged = 0;
+  for (std::size_t i = 0; i < guarded.size(); ++i) {
+    const bool outlier = std::find(in.outliers.begin(), in.outliers.end(), i) != in.outliers.end();
+    if (guarded[i].flags & kHeld) {
+      EXPECT_TRUE(outlier) << i;
+      ++flagged;
+    }
+    EXPECT_LT(so3::dist(guarded[i].measured, in.samples[i].orientation), 1e-12);
+  }
+  EXPECT_EQ(flagged, w.counters().held - w.counters().released);
+  // The outliers no longer break the rest: a fraction of the error, rotation and position alike.
+  EXPECT_LT(rotation_rms(guarded), 0.6 * rotation_rms(plain));
+  EXPECT_LT(position_rms(guarded), 0.6 * position_rms(plain));
+}
+
+TEST(OutlierGuardInTheEngine, AtLagZeroNothingIsHeldByDefault) {
+  const StillWithOutliers in = still_with_outliers(false, 7);
+  FairingWindow w{WindowConfig{}};
+  const auto out = run(w, in.samples);
+  EXPECT_EQ(w.counters().held, 0u);
+  // Given a threshold, lag 0 holds them too (its first sample of a sudden motion as well).
+  WindowConfig given;
+  given.outlier_threshold = kDefaultOutlierThreshold;
+  FairingWindow g(given);
+  run(g, in.samples);
+  EXPECT_GE(g.counters().held, in.outliers.size() * 9 / 10);
+}
+
+TEST(OutlierGuardInTheEngine, TheBoundIsOnTheMeasurementOfAHeldSample) {
+  // ε promises every output within ε of its measurement, an outlier's too: a held sample's pose
+  // is projected onto the ball around what was measured, not around the prediction.
+  const StillWithOutliers in = still_with_outliers(true, 8);
+  WindowConfig c;
+  c.lag = 1;
+  c.epsilon_r = 0.02;
+  c.epsilon_t = 0.03;
+  FairingWindow w(c);
+  const auto out = run(w, in.samples);
+  EXPECT_GE(w.counters().held, in.outliers.size() * 9 / 10);
+  std::size_t clamped_held = 0;
+  for (const FairedPose& p : out) {
+    EXPECT_LE(so3::dist(p.orientation, p.measured), c.epsilon_r * (1.0 + 1e-9));
+    EXPECT_LE((p.position - p.measured_position).norm(), c.epsilon_t * (1.0 + 1e-9));
+    if ((p.flags & kHeld) && (p.flags & kClamped)) ++clamped_held;
+  }
+  EXPECT_EQ(clamped_held, w.counters().held - w.counters().released);
+}
+
+TEST(OutlierGuardInTheEngine, AQuickTurnsStartIsReleasedBeforeItIsEmitted) {
+  // 60° in 0.1 s at 60 Hz, from still, with little noise: its first sample is as far off the
+  // line as an outlier. With a lag the next sample releases it before it is emitted, so no pose
+  // is held and the turn is followed as without the guard.
+  const double rate = 60.0;
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  std::vector<Sample> in;
+  std::vector<Quat> truth;
+  for (int i = 0; i < 20 * static_cast<int>(rate); ++i) {
+    const double t = i / rate;
+    double yaw = 0.0;
+    for (int k = 0; k < 10; ++k) {
+      const double u = std::clamp((t - 1.0 - 2.0 * k - 0.3 * std::sin(static_cast<double>(k))) / 0.1, 0.0, 1.0);
+      yaw += (k % 2 ? -1.0 : 1.0) * std::numbers::pi / 3.0 * u * u * (3.0 - 2.0 * u);
+    }
+    truth.push_back(so3::from_rotation_vector(Vec3(0.0, 0.0, yaw)));
+    Sample s;
+    s.time = t;
+    s.orientation = truth.back() * so3::from_rotation_vector(Vec3(noise(rng), noise(rng), noise(rng)));
+    in.push_back(s);
+  }
+  WindowConfig on;
+  on.lag = 1;
+  WindowConfig off = on;
+  off.outlier_threshold = 0.0;
+  FairingWindow w(on);
+  const auto guarded = run(w, in);
+  const auto plain = run(off, in);
+  EXPECT_GT(w.counters().held, 0u);
+  EXPECT_EQ(w.counters().released, w.counters().held);
+  double e_on = 0.0, e_off = 0.0;
+  for (std::size_t i = 0; i < guarded.size(); ++i) {
+    EXPECT_EQ(guarded[i].flags & kHeld, 0u) << i;
+    e_on += std::pow(so3::rotation_angle(guarded[i].orientation, truth[i]), 2);
+    e_off += std::pow(so3::rotation_angle(plain[i].orientation, truth[i]), 2);
+  }
+  EXPECT_LT(e_on, 1.02 * e_off);
+}
+
+}  // namespace
+}  // namespace posefair
