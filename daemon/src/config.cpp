@@ -141,7 +141,7 @@ constexpr std::string_view kEngineKeys[] = {
     "window",   "window_time", "max_window", "lag", "horizon", "order", "solver", "iterations", "smoothing", "smoothing_r",
     "smoothing_t", "cutoff_hz", "rate_hz", "noise_time", "motion_time", "motion_span", "motion_margin", "rest_threshold", "rest_memory", "continuity",
     "lambda_r", "lambda_t", "variant",
-    "epsilon_r", "epsilon_t", "bound",  "gap",       "gap_intervals", "unit_tolerance", "gyro_aided", "gyro_time_offset",
+    "epsilon_r", "epsilon_t", "bound",  "gap",       "gap_intervals", "unit_tolerance", "outlier_threshold", "gyro_aided", "gyro_time_offset",
     "gyro_estimate_offset", "gyro_mounting", "gyro_stream"};
 constexpr std::string_view kStreamKeys[] = {"id",     "name", "ring_capacity", "overflow", "driver", "engine",
                                             "spline", "gpio", "fusion",        "mounting", "world",  "busy_poll"};
@@ -326,7 +326,7 @@ struct EngineLayer {
   std::optional<Given<int>> window, max_window, lag, order, iterations;
   std::optional<Given<WindowSolver>> solver;
   std::optional<Given<double>> window_time, horizon, smoothing, smoothing_r, smoothing_t, cutoff_hz, rate_hz, continuity, lambda_r,
-      lambda_t, epsilon_r, epsilon_t, gap, gap_intervals, unit_tolerance;
+      lambda_t, epsilon_r, epsilon_t, gap, gap_intervals, unit_tolerance, outlier_threshold;
   // The adaptation's time constants and margin (core/smoothing_adaptation.hpp).
   std::optional<Given<double>> noise_time, motion_time, motion_span, motion_margin, rest_threshold, rest_memory;
   std::optional<Given<OperatorVariant>> variant;
@@ -609,6 +609,7 @@ class Parser {
     real("gap", e.gap, kPositive);
     real("gap_intervals", e.gap_intervals, kNonNegative);
     real("unit_tolerance", e.unit_tolerance, FloatRange{0.0, true, 1.0, true});
+    real("outlier_threshold", e.outlier_threshold, FloatRange{0.0, false, kMaxOutlierThreshold, false});
     for (auto [name, field] : {std::pair{"gyro_aided", &e.gyro_aided}, std::pair{"gyro_estimate_offset", &e.gyro_estimate_offset}})
       if (const toml::node* n = t.get(name)) {
         const std::string key = join_key(prefix, name);
@@ -678,6 +679,7 @@ class Parser {
       take(layer->gap, c.gate.gap_threshold, EngineSetting::GapThreshold);
       take(layer->gap_intervals, c.gate.gap_intervals, EngineSetting::GapThreshold);
       take(layer->unit_tolerance, c.gate.unit_tolerance, EngineSetting::UnitTolerance);
+      take(layer->outlier_threshold, c.outlier_threshold, EngineSetting::OutlierThreshold);
       take(layer->noise_time, c.adaptation.noise_time_s, EngineSetting::Adaptation);
       take(layer->motion_time, c.adaptation.motion_time_s, EngineSetting::Adaptation);
       take(layer->motion_span, c.adaptation.motion_span_s, EngineSetting::Adaptation);

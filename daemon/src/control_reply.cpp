@@ -201,6 +201,8 @@ std::string streams_member(const std::vector<StreamStats>& now, const std::vecto
                 .add("rejected", s.rejected)
                 .add("out_of_order", s.out_of_order)
                 .add("clamped", s.clamped)
+                .add("outliers_held", s.outliers_held)
+                .add("outliers_released", s.outliers_released)
                 .add("restarts", s.restarts)
                 .add("rate_changes", s.rate_changes)
                 .add("published", s.published)

@@ -517,6 +517,8 @@ bool Pipeline::stream_pass(Stream& s) {
   s.counters.out_of_order.store(g.dropped(), std::memory_order_relaxed);
   s.counters.emitted.store(w.emitted, std::memory_order_relaxed);
   s.counters.clamped.store(w.clamped, std::memory_order_relaxed);
+  s.counters.outliers_held.store(w.held, std::memory_order_relaxed);
+  s.counters.outliers_released.store(w.released, std::memory_order_relaxed);
   s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
   s.counters.rate_changes.store(w.rate_changes, std::memory_order_relaxed);
   s.counters.gyro.bridged.store(w.gyro_bridged, std::memory_order_relaxed);
@@ -697,6 +699,8 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.raw_unfused = get(s.counters.raw_unfused);
     st.emitted = get(s.counters.emitted);
     st.clamped = get(s.counters.clamped);
+    st.outliers_held = get(s.counters.outliers_held);
+    st.outliers_released = get(s.counters.outliers_released);
     st.restarts = get(s.counters.restarts);
     st.rate_changes = get(s.counters.rate_changes);
     st.gyro_bridged = get(s.counters.gyro.bridged);

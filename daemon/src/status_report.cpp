@@ -120,6 +120,10 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
                   us(s.latency.percentile(50)), us(s.latency.percentile(90)), us(s.latency.percentile(99)),
                   us(s.latency.max));
     lines.emplace_back(buf);
+    if (s.outliers_held > 0) {
+      std::snprintf(buf, sizeof buf, ", outliers held %" PRIu64 " (released %" PRIu64 ")", s.outliers_held, s.outliers_released);
+      lines.back() += buf;
+    }
     if (s.rate_changes > 0) {  // restarts the stream caused by changing its rate, not by a gap
       std::snprintf(buf, sizeof buf, ", rate changes %" PRIu64 " (of the restarts)", s.rate_changes);
       lines.back() += buf;

@@ -94,6 +94,7 @@ motion_span = 0.5
 motion_margin = 3
 rest_threshold = 3          # 0: never at rest
 rest_memory = 2.5           # s; 0: the window's smoothing at rest
+outlier_threshold = 10      # multiples of the median distance from the prediction; 0: off
 
 [[stream]]
 id = 7
@@ -226,6 +227,7 @@ TEST(Config, AFullConfigFillsEveryField) {
     EXPECT_EQ(e.adaptation.motion_margin, 1.5);
     EXPECT_EQ(e.adaptation.rest_threshold, 3.0);
     EXPECT_EQ(e.adaptation.rest_memory_s, 2.5);
+    EXPECT_EQ(e.outlier_threshold, 10.0);
   }
   {
     const StreamConfig& s = c.streams[1];
@@ -1570,6 +1572,12 @@ name = "a"
 driver = { type = "synthetic", rate_hz = 100 }
 engine = { rest_memory = 601 }
 )", "stream[1].engine.rest_memory: out of range: must be in [0, 600], got 601", 5},
+    {"negative outlier_threshold", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+engine = { outlier_threshold = -1 }
+)", "stream[1].engine.outlier_threshold: out of range: must be in [0, 1000], got -1", 5},
     {"continuity with adapted smoothing", R"([engine]
 window = 32
 continuity = 1

@@ -167,6 +167,12 @@ TEST(StatusReport, AGyroFromAnotherStreamShowsItsSourceAndMatches) {
       << counter_lines({s}, {}, 0.0)[0];
   EXPECT_NE(status_line({s}, {}, 1.0).find(" gyro from imu unmatched 100 gyro dt 4.0ms bias 0.00deg/s"), std::string::npos)
       << status_line({s}, {}, 1.0);
+  // The outlier guard's counts, once it has held a sample (and in `posefair ctl status` always).
+  EXPECT_EQ(counter_lines({s}, {}, 0.0)[0].find("outliers held"), std::string::npos);
+  s.outliers_held = 12;
+  s.outliers_released = 3;
+  EXPECT_NE(counter_lines({s}, {}, 0.0)[0].find(", outliers held 12 (released 3)"), std::string::npos) << counter_lines({s}, {}, 0.0)[0];
+  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("outliers_held":12,"outliers_released":3)"), std::string::npos);
   // `posefair ctl status`: the same counts in the stream's gyro object.
   const std::string json = streams_member({s}, {}, 1.0);
   EXPECT_NE(json.find(R"("intervals":1390,"bridged":7,"source":"imu","matched":1400,"unmatched":100)"), std::string::npos) << json;

@@ -24,6 +24,8 @@ struct StreamCounters {
   std::atomic<std::uint64_t> raw_unfused{0};      // raw-only samples (kNoOrientation) kept out of the engine: no fusion stage made an orientation
   std::atomic<std::uint64_t> emitted{0};          // poses the engine produced
   std::atomic<std::uint64_t> clamped{0};          // of which the ε projection moved
+  std::atomic<std::uint64_t> outliers_held{0};     // lone outliers held at the prediction (outlier_guard.hpp)
+  std::atomic<std::uint64_t> outliers_released{0}; // of those, released: the next sample showed a motion
   std::atomic<std::uint64_t> restarts{0};         // windows restarted after a gap or a change of rate
   std::atomic<std::uint64_t> rate_changes{0};     // of which for a change of the measured rate
   std::atomic<std::uint64_t> bridged_gaps{0};     // input gaps filled on the spline ([stream.spline] bridge_gap)
@@ -85,6 +87,7 @@ struct StreamStats {
   bool driver_running = false;
   std::uint64_t received = 0, ring_dropped = 0, rejected = 0, out_of_order = 0, emitted = 0, clamped = 0, restarts = 0;
   std::uint64_t rate_changes = 0;  // of the restarts, for a change of the measured rate
+  std::uint64_t outliers_held = 0, outliers_released = 0;  // the outlier guard (outlier_guard.hpp)
   std::uint64_t gyro_bridged = 0;  // gyro readings missing from an aided window, bridged (no restart)
   std::uint64_t raw_unfused = 0;  // raw-only samples not faired (no orientation, no fusion stage); still recorded
   std::uint64_t publish_dropped = 0, published = 0, send_failures = 0, recorded = 0, record_dropped = 0;
