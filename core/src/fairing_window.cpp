@@ -682,6 +682,7 @@ void FairingWindow::slide(int count) {
 bool FairingWindow::hold_outliers(const Sample& s, double step, Quat& z, Vec3& p, char& held) {
   using Verdict = OutlierGuard::Verdict;
   held = 0;
+  if (!rot_guard_.on()) return false;
   if (n_ == 0 || step <= 0.0) {
     rot_guard_.restart();
     pos_guard_.restart();

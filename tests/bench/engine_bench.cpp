@@ -96,6 +96,16 @@ void BM_DefaultsAtRest(benchmark::State& state) {
   run_window(state, c, still_stream(), false);
 }
 BENCHMARK(BM_DefaultsAtRest)->ArgNames({"rest_line"})->Arg(1)->Arg(0);
+
+// The defaults with a lag of one sample, with the outlier guard (on by default with a lag,
+// outlier_guard.hpp) and without it; with positions, both channels guarded.
+void BM_DefaultsWithLag(benchmark::State& state) {
+  WindowConfig c;
+  c.lag = 1;
+  if (state.range(1) == 0) c.outlier_threshold = 0.0;
+  run_window(state, c, stream(state.range(0) != 0).noisy, state.range(0) != 0);
+}
+BENCHMARK(BM_DefaultsWithLag)->ArgNames({"pos", "guard"})->Args({0, 1})->Args({0, 0})->Args({1, 1})->Args({1, 0});
 BENCHMARK(BM_Linear)
     ->ArgNames({"W", "m", "kappa", "pos"})
     ->Args({32, 2, 0, 0})  // the old default

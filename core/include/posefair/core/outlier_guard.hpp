@@ -56,6 +56,7 @@ class OutlierGuard {
   // The sample `step` seconds after the previous one, `increment` from it (from the held
   // prediction, if the previous sample was held).
   Verdict check(double step, Vec3& increment);
+  bool on() const { return threshold_ > 0.0; }
   // A new window: the line starts afresh (the median, the stream's own, carries on).
   void restart() {
     count_ = 0;
