@@ -649,6 +649,35 @@ TEST(Pipeline, AStillTrackerIsReportedAtRestAndAveragedOverSeconds) {
   }
 }
 
+// A still tracker with three samples thrown 0.2 rad off: with `lag = 1` the engine holds each
+// (the outlier guard is on by default with a lag) and the stats say so; at lag 0 it is off.
+TEST(Pipeline, OutliersHeldByTheEngineReachTheStats) {
+  ScratchDir dir;
+  std::vector<Sample> still;
+  for (int k = 0; k < 600; ++k) {
+    Sample s;
+    s.stream_id = 1;
+    s.sequence = static_cast<std::uint64_t>(k);
+    s.time = k / 100.0;
+    Vec3 r = (k % 2 == 0 ? 0.002 : -0.002) * Vec3(1.0, -1.0, 0.5) + 0.0005 * Vec3(k % 3, k % 5, k % 7);
+    if (k == 200 || k == 350 || k == 500) r += Vec3(0.2, 0.0, 0.0);
+    s.orientation = so3::exp(r);
+    still.push_back(s);
+  }
+  write_imu_log(dir / "in.pflog", still);
+  for (const std::string lag : {"lag = 1\n", "lag = 0\n"}) {
+    SCOPED_TRACE(lag);
+    const std::string text = "[[stream]]\nid = 1\nname = \"tracker\"\nring_capacity = 4096\n"
+                             "[stream.driver]\ntype = \"replay\"\npath = \"" +
+                             (dir / "in.pflog").string() + "\"\ntiming = \"fast\"\n[stream.engine]\n" + lag +
+                             "\n[[output]]\ndestinations = [\"127.0.0.1:9\"]\n";
+    const StreamStats st = run_to_end(parse_config(text, "/virtual/outliers.toml"));
+    EXPECT_EQ(st.emitted, still.size());
+    EXPECT_EQ(st.outliers_held, lag == "lag = 1\n" ? 3u : 0u);
+    EXPECT_EQ(st.outliers_released, 0u);
+  }
+}
+
 // The same receive times: resampled onto a 90 Hz grid, and limited to 100 poses a second. Both
 // place the poses at the times the samples were taken (sampled_clock.hpp), not at their stamps:
 // through knots 1 µs apart the spline's grid poses were radians off, and by the stamps the limit
