@@ -621,57 +621,52 @@ TEST(Pipeline, TheBodyRateOfSamplesStampedInClumpsIsOverTheirInterval) {
   EXPECT_GT(checked, 500u);
 }
 
-// A tracker lying still, its noise alternating in sign from sample to sample (no random draw
-// decides whether the rest line is straight at the last sample: it is): the daemon reports
-// what the engine does at rest, averaged over seconds by default and not with rest_memory = 0.
-TEST(Pipeline, AStillTrackerIsReportedAtRestAndAveragedOverSeconds) {
-  ScratchDir dir;
+// A tracker lying still for 6 s at 100 Hz, its noise alternating in sign from sample to sample,
+// plus `off(k)` on sample k; and a config replaying it with these [stream.engine] keys.
+std::vector<Sample> still_tracker(const std::function<Vec3(int)>& off) {
   std::vector<Sample> still;
   for (int k = 0; k < 600; ++k) {
     Sample s;
     s.stream_id = 1;
     s.sequence = static_cast<std::uint64_t>(k);
     s.time = k / 100.0;
-    s.orientation = so3::exp((k % 2 == 0 ? 0.002 : -0.002) * Vec3(1.0, -1.0, 0.5));
+    s.orientation = so3::exp((k % 2 == 0 ? 0.002 : -0.002) * Vec3(1.0, -1.0, 0.5) + off(k));
     still.push_back(s);
   }
+  return still;
+}
+std::string replayed_tracker(const std::filesystem::path& log, const std::string& engine_keys) {
+  return "[[stream]]\nid = 1\nname = \"tracker\"\nring_capacity = 4096\n[stream.driver]\ntype = \"replay\"\npath = \"" +
+         log.string() + "\"\ntiming = \"fast\"\n[stream.engine]\n" + engine_keys +
+         "\n[[output]]\ndestinations = [\"127.0.0.1:9\"]\n";
+}
+
+// The still tracker (no random draw decides whether the rest line is straight at the last
+// sample: it is): the daemon reports what the engine does at rest, averaged over seconds by
+// default and not with rest_memory = 0.
+TEST(Pipeline, AStillTrackerIsReportedAtRestAndAveragedOverSeconds) {
+  ScratchDir dir;
+  const std::vector<Sample> still = still_tracker([](int) { return Vec3::Zero(); });
   write_imu_log(dir / "in.pflog", still);
   for (const std::string memory : {"", "rest_memory = 0\n"}) {
     SCOPED_TRACE(memory.empty() ? "defaults" : memory);
-    const std::string text = "[[stream]]\nid = 1\nname = \"tracker\"\nring_capacity = 4096\n"
-                             "[stream.driver]\ntype = \"replay\"\npath = \"" +
-                             (dir / "in.pflog").string() + "\"\ntiming = \"fast\"\n[stream.engine]\n" + memory +
-                             "\n[[output]]\ndestinations = [\"127.0.0.1:9\"]\n";
-    const StreamStats st = run_to_end(parse_config(text, "/virtual/still.toml"));
+    const StreamStats st = run_to_end(parse_config(replayed_tracker(dir / "in.pflog", memory), "/virtual/still.toml"));
     EXPECT_EQ(st.emitted, still.size());
     EXPECT_TRUE(st.engine.rotation.at_rest);
     EXPECT_EQ(st.engine.rotation.rest_averaged, memory.empty());
   }
 }
 
-// A still tracker with three samples thrown 0.2 rad off: with `lag = 1` the engine holds each
+// The still tracker with three samples thrown 0.2 rad off: with `lag = 1` the engine holds each
 // (the outlier guard is on by default with a lag) and the stats say so; at lag 0 it is off.
 TEST(Pipeline, OutliersHeldByTheEngineReachTheStats) {
   ScratchDir dir;
-  std::vector<Sample> still;
-  for (int k = 0; k < 600; ++k) {
-    Sample s;
-    s.stream_id = 1;
-    s.sequence = static_cast<std::uint64_t>(k);
-    s.time = k / 100.0;
-    Vec3 r = (k % 2 == 0 ? 0.002 : -0.002) * Vec3(1.0, -1.0, 0.5) + 0.0005 * Vec3(k % 3, k % 5, k % 7);
-    if (k == 200 || k == 350 || k == 500) r += Vec3(0.2, 0.0, 0.0);
-    s.orientation = so3::exp(r);
-    still.push_back(s);
-  }
+  const std::vector<Sample> still =
+      still_tracker([](int k) { return k == 200 || k == 350 || k == 500 ? Vec3(0.2, 0.0, 0.0) : Vec3::Zero(); });
   write_imu_log(dir / "in.pflog", still);
   for (const std::string lag : {"lag = 1\n", "lag = 0\n"}) {
     SCOPED_TRACE(lag);
-    const std::string text = "[[stream]]\nid = 1\nname = \"tracker\"\nring_capacity = 4096\n"
-                             "[stream.driver]\ntype = \"replay\"\npath = \"" +
-                             (dir / "in.pflog").string() + "\"\ntiming = \"fast\"\n[stream.engine]\n" + lag +
-                             "\n[[output]]\ndestinations = [\"127.0.0.1:9\"]\n";
-    const StreamStats st = run_to_end(parse_config(text, "/virtual/outliers.toml"));
+    const StreamStats st = run_to_end(parse_config(replayed_tracker(dir / "in.pflog", lag), "/virtual/outliers.toml"));
     EXPECT_EQ(st.emitted, still.size());
     EXPECT_EQ(st.outliers_held, lag == "lag = 1\n" ? 3u : 0u);
     EXPECT_EQ(st.outliers_released, 0u);
