@@ -682,7 +682,9 @@ void FairingWindow::slide(int count) {
 bool FairingWindow::hold_outliers(const Sample& s, double step, Quat& z, Vec3& p, char& held) {
   using Verdict = OutlierGuard::Verdict;
   held = 0;
-  if (!rot_guard_.on()) return false;
+  // Not in a gyro-aided window: its residuals and bias estimate take each increment in for
+  // good, so a release could not take a held one back.
+  if (!rot_guard_.on() || aided_) return false;
   if (n_ == 0 || step <= 0.0) {
     rot_guard_.restart();
     pos_guard_.restart();
