@@ -250,6 +250,25 @@ TEST(OutlierGuardInTheEngine, TheBoundIsOnTheMeasurementOfAHeldSample) {
   EXPECT_EQ(clamped_held, w.counters().held - w.counters().released);
 }
 
+TEST(OutlierGuardInTheEngine, AGyroAidedWindowIsNotGuarded) {
+  // Its residuals and bias estimate keep every increment, so a release could not take a held
+  // one back: the same still stream with a (still) gyroscope on every sample holds nothing.
+  StillWithOutliers in = still_with_outliers(false, 10);
+  WindowConfig c;
+  c.lag = 1;
+  FairingWindow plain(c);
+  run(plain, in.samples);
+  EXPECT_GE(plain.counters().held, in.outliers.size() * 9 / 10);
+  for (Sample& s : in.samples) {
+    s.gyro = Vec3::Zero();
+    s.flags |= kHasGyro;
+  }
+  FairingWindow aided(c);
+  run(aided, in.samples, false);
+  EXPECT_TRUE(aided.state().gyro.active);
+  EXPECT_EQ(aided.counters().held, 0u);
+}
+
 TEST(OutlierGuardInTheEngine, AQuickTurnsStartIsReleasedBeforeItIsEmitted) {
   // 60° in 0.1 s at 60 Hz, from still, with little noise: its first sample is as far off the
   // line as an outlier. With a lag the next sample releases it before it is emitted, so no pose
