@@ -47,13 +47,17 @@ OutlierGuard::Verdict OutlierGuard::check(double step, Vec3& increment) {
       const Vec3 predicted = at_zero + slope * step;
       const double distance = (increment - predicted).norm() / scale_;
       const double median = std::exp(log_median_);
-      const bool held_now = seen_ >= kOutlierWarmUp && distance > kOutlierFloor &&
-                            distance > threshold_ * median && ordinary_before_;
-      ordinary_before_ = seen_ >= kOutlierWarmUp && distance <= kOrdinary * median;
+      const bool warm = seen_ >= kOutlierWarmUp;
+      const bool held_now = warm && distance > kOutlierFloor && distance > threshold_ * median && ordinary_before_;
+      ordinary_before_ = warm && distance <= kOrdinary * median;
       const double log_distance = std::log(std::max(distance, 1e-300));
-      if (seen_ < kOutlierWarmUp) log_median_ = seen_ == 0 ? log_distance : std::max(log_median_, log_distance);
-      else log_median_ += kRate * (log_distance > log_median_ ? 1.0 : -1.0);
-      ++seen_;
+      if (warm) {
+        log_median_ += kRate * (log_distance > log_median_ ? 1.0 : -1.0);
+      } else {
+        // Counted only up to the warm-up: a daemon's stream outlives an int's count of samples.
+        log_median_ = seen_ == 0 ? log_distance : std::max(log_median_, log_distance);
+        ++seen_;
+      }
       if (held_before && (increment - held_offset_).norm() < (increment - predicted).norm()) {
         // A motion started: the held sample goes back to its measurement, in the ring too.
         const int previous = (head_ + kOutlierFitPoints - 2) % (kOutlierFitPoints - 1);

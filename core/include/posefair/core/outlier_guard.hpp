@@ -72,7 +72,7 @@ class OutlierGuard {
   int head_ = 0;
   int count_ = 0;
   double log_median_ = 0.0;
-  int seen_ = 0;
+  int seen_ = 0;  // distances seen, up to kOutlierWarmUp
   bool ordinary_before_ = false;  // the sample before landed within twice the median
   bool held_before_ = false;      // the sample before was held; held_offset_: its measurement from the prediction
   Vec3 held_offset_ = Vec3::Zero();
