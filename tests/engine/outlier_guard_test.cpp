@@ -32,7 +32,9 @@ std::vector<Verdict> feed(OutlierGuard& guard, const std::vector<Vec3>& x, doubl
     verdicts.push_back(v);
     if (v == Verdict::Release) kept = x[i - 1];
     kept += increment;
-    if (v != Verdict::Hold) EXPECT_LT((kept - x[i]).norm(), 1e-12) << i;
+    if (v != Verdict::Hold) {
+      EXPECT_LT((kept - x[i]).norm(), 1e-12) << i;
+    }
   }
   return verdicts;
 }
