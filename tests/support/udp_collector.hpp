@@ -71,6 +71,11 @@ class UdpCollector {
     return static_cast<std::size_t>(
         std::count_if(got_.begin(), got_.end(), [&](const Got& g) { return g.m.stream == stream; }));
   }
+  // How many of them `keep` picks (a stream in a session, say).
+  std::size_t count_if(const std::function<bool(const daemon::PoseMessage&)>& keep) const {
+    std::lock_guard lock(mutex_);
+    return static_cast<std::size_t>(std::count_if(got_.begin(), got_.end(), [&](const Got& g) { return keep(g.m); }));
+  }
   // The datagrams that did not (truncated, or refused by the decoder).
   std::size_t malformed() const {
     std::lock_guard lock(mutex_);
