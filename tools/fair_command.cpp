@@ -123,7 +123,7 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
       std::printf("outliers %llu held at the prediction (threshold %g), %llu of them released as a motion's start\n",
                   static_cast<unsigned long long>(r.counters.held), threshold, static_cast<unsigned long long>(r.counters.released));
     else
-      std::printf("outliers not guarded (%s)\n", c.outlier_threshold ? "--outlier-threshold 0" : "lag 0; --outlier-threshold turns the guard on");
+      std::printf("outliers not guarded (%s)\n", c.outlier_threshold ? "--outlier-threshold 0" : "an iterative solver at lag 0; --outlier-threshold turns the guard on");
     print_deviation_line(r.max_dist_r, in.has_position(), r.max_deviation_t);
     std::printf("cost     %.0f ns per sample\nwrote    %s\n", 1e9 * seconds / std::max<std::size_t>(1, in.size()), o.output.c_str());
   }
@@ -276,7 +276,7 @@ void add_fair_command(CLI::App& app, int& exit_code) {
       ->capture_default_str()
       ->needs(causal);
   cmd->add_option("--outlier-threshold", o->window.outlier_threshold,
-                  "causal: hold a lone sample this many times the median distance from the prediction of the ones before it (0: off; default 8 with a lag, off without)")
+                  "causal: hold a lone sample this many times the median distance from the prediction of the ones before it (0: off; default 8, off for an iterative solver at lag 0)")
       ->check(CLI::Range(0.0, kMaxOutlierThreshold))
       ->needs(causal);
   cmd->callback([o, &exit_code] { exit_code = run_fair(*o); });

@@ -161,7 +161,8 @@ double cutoff_for_smoothing(double mu, double rate_hz, int order) {
 
 double outlier_threshold(const WindowConfig& config) {
   if (config.outlier_threshold) return *config.outlier_threshold;
-  return config.lag > 0 ? kDefaultOutlierThreshold : 0.0;
+  // At lag 0 only the linear solver can emit a held sample as the measurement (push, put_held).
+  return config.lag > 0 || config.solver == WindowSolver::Linear ? kDefaultOutlierThreshold : 0.0;
 }
 
 FairingWindow::Channel::Channel(int capacity, int order) : fixed(make_emission_row(capacity)), estimator(capacity, order) {}
@@ -416,7 +417,7 @@ EngineState FairingWindow::state() const {
       out.noise = unit * std::sqrt(3.0 * estimator.noise_variance());
       out.at_rest = estimator.at_rest();
       out.motion = dt > 0.0 ? unit * std::sqrt(3.0 * estimator.motion_variance()) / std::pow(dt, config_.order) : 0.0;
-      out.rest_averaged = ch.rest_averaged;
+      out.rest_averaged = ch.rest.averaged;
     }
   }
   return s;
@@ -442,18 +443,18 @@ void FairingWindow::follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta) {
   const bool still = ch.adaptive && prepared_ && memory > 0.0 && !(&ch == &rot_ && aided_) && n_ == w_ &&
                      ch.estimator.at_rest();
   if (!still) {
-    ch.resting = false;
+    ch.rest.resting = false;
     return;
   }
   auto feed = [&](int from) {
     for (int i = from; i < n_; ++i) {
       const auto j = static_cast<std::size_t>(i);
-      if (i > 0 && !ch.rest_line.empty()) ch.rest_theta += zeta[j - 1];
-      ch.rest_line.add(i > 0 ? samples_[j].time - samples_[j - 1].time : 0.0, ch.rest_theta, memory);
+      if (i > 0 && !ch.rest.line.empty()) ch.rest.theta += zeta[j - 1];
+      ch.rest.line.add(i > 0 ? samples_[j].time - samples_[j - 1].time : 0.0, ch.rest.theta, memory);
     }
-    ch.rest_time = samples_[static_cast<std::size_t>(n_ - 1)].time;
+    ch.rest.time = samples_[static_cast<std::size_t>(n_ - 1)].time;
   };
-  if (ch.resting) {
+  if (ch.rest.resting) {
     feed(n_ - 1);
     return;
   }
@@ -461,17 +462,17 @@ void FairingWindow::follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta) {
   // slope is noisy too, so it does now and then), the line takes the samples it missed from the
   // window and goes on, if it is still straight; otherwise it starts from the window's samples.
   int last = -1;
-  if (!ch.rest_line.empty())
+  if (!ch.rest.line.empty())
     for (int i = n_ - 1; i >= 0 && last < 0; --i)
-      if (samples_[static_cast<std::size_t>(i)].time == ch.rest_time) last = i;
+      if (samples_[static_cast<std::size_t>(i)].time == ch.rest.time) last = i;
   if (last >= 0) feed(last + 1);
-  const std::optional<RestLine::Value> value = ch.rest_line.value_at(0.0, ch.estimator.noise_variance(), kRestLineFactor);
+  const std::optional<RestLine::Value> value = ch.rest.line.value_at(0.0, ch.estimator.noise_variance(), kRestLineFactor);
   if (last < 0 || !value || !value->straight) {
-    ch.rest_line.reset();
-    ch.rest_theta = Vec3::Zero();
+    ch.rest.line.reset();
+    ch.rest.theta = Vec3::Zero();
     feed(0);
   }
-  ch.resting = true;
+  ch.rest.resting = true;
 }
 
 // Sample k's correction (in its chart, as linear_correction's): the window's, moved toward the
@@ -479,24 +480,24 @@ void FairingWindow::follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta) {
 // switch would step the output, and a stream at the edge of rest switches often). A motion
 // seen at rest takes the window's at once, as leaving rest does.
 Vec3 FairingWindow::rest_blend(Channel& ch, const SlidingArray<Vec3>& zeta, int k, const Vec3& window, double dt) {
-  ch.rest_averaged = false;
+  ch.rest.averaged = false;
   const auto newest = static_cast<std::size_t>(n_ - 1);
   const double age = samples_[newest].time - samples_[static_cast<std::size_t>(k)].time - config_.horizon_s;
   const std::optional<RestLine::Value> value =
-      ch.resting && ch.estimator.motion_variance() == 0.0
-          ? ch.rest_line.value_at(age, ch.estimator.noise_variance(), kRestLineFactor)
+      ch.rest.resting && ch.estimator.motion_variance() == 0.0
+          ? ch.rest.line.value_at(age, ch.estimator.noise_variance(), kRestLineFactor)
           : std::nullopt;
   if (!value) {
-    ch.rest_weight = 0.0;
+    ch.rest.weight = 0.0;
     return window;
   }
-  ch.rest_averaged = value->straight;
+  ch.rest.averaged = value->straight;
   const double target = value->straight ? 1.0 : 0.0;
-  ch.rest_weight += (target - ch.rest_weight) * (1.0 - std::exp(-std::max(dt, 0.0) / config_.adaptation.motion_time_s));
-  if (!(ch.rest_weight > 0.0)) return window;
-  Vec3 theta_k = ch.rest_theta;
+  ch.rest.weight += (target - ch.rest.weight) * (1.0 - std::exp(-std::max(dt, 0.0) / config_.adaptation.motion_time_s));
+  if (!(ch.rest.weight > 0.0)) return window;
+  Vec3 theta_k = ch.rest.theta;
   for (int j = k; j < n_ - 1; ++j) theta_k -= zeta[static_cast<std::size_t>(j)];
-  return window + ch.rest_weight * (value->line - theta_k - window);
+  return window + ch.rest.weight * (value->line - theta_k - window);
 }
 
 // Constant angular (and linear) velocity from the last accepted measurement to the newest,
@@ -609,7 +610,21 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   Quat held_z;
   Vec3 held_p;
   char held = 0;
-  if (hold_outliers(s, dt > 0.0 ? gate_.sampled_step() : 0.0, held_z, held_p, held)) {
+  const bool linear = config_.solver == WindowSolver::Linear;
+  const bool hold = hold_outliers(s, dt > 0.0 ? gate_.sampled_step() : 0.0, held_z, held_p, held);
+  before_hold_dt_ = -1.0;
+  // At lag 0 a held sample is emitted before the next one can release it, and a sudden
+  // motion's first sample looks just like an outlier: so it is emitted as the window would
+  // emit the measurement, and the prediction takes its place only after (put_held below), for
+  // the poses after it and what the adaptation learns.
+  const bool emit_measured = hold && config_.lag == 0 && linear;
+  if (hold) {
+    ++counters_.held;
+    rot_before_hold_ = learnt(rot_);
+    pos_before_hold_ = learnt(pos_);
+    before_hold_dt_ = dt;
+  }
+  if (hold && !emit_measured) {
     Sample h = s;
     h.orientation = held_z;
     h.position = held_p;
@@ -618,13 +633,12 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
     samples_[k].orientation = s.orientation;  // emitted as measured, and bounded by it
     samples_[k].position = s.position;
     held_[k] = held;
-    ++counters_.held;
   } else {
     append(s);
   }
   if (!prepared_) note_interval(dt);
   const int k = n_ - 1 - config_.lag;
-  if (config_.solver == WindowSolver::Linear) {
+  if (linear) {
     // Only the emitted sample's estimate is needed: one precomputed dot product (two while
     // the adapted smoothing lies between levels).
     linear_emission_estimate(k, dt);
@@ -645,7 +659,36 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   last_p_ = s.position;
   last_has_position_ = s.has_position();
   if (k >= 0) out[static_cast<std::size_t>(count++)] = emit(k);
+  if (emit_measured) put_held(held_z, held_p, held, dt);
   return count;
+}
+
+// Lag 0: the newest sample, just emitted as measured, takes the prediction it was held at, and
+// the adaptation learns from that instead.
+void FairingWindow::put_held(const Quat& z, const Vec3& p, char held, double dt) {
+  const auto k = static_cast<std::size_t>(n_ - 1);
+  if (held & kHeldRotation) {
+    z_[k] = z;
+    if (k > 0) zeta_[k - 1] = so3::log(z_[k - 1].conjugate() * z);
+    if (config_.continuity > 0.0) c_[k] = so3::log(z.conjugate() * y_[k]);
+  }
+  if (positions_ && (held & kHeldPosition)) {
+    zp_[k] = p;
+    if (k > 0) dzp_[k - 1] = p - zp_[k - 1];
+    if (config_.continuity > 0.0) cp_[k] = yp_[k] - p;
+  }
+  held_[k] = held;
+  last_z_ = z_[k];
+  restore(rot_, rot_before_hold_);
+  restore(pos_, pos_before_hold_);
+  linear_emission_estimate(n_ - 1, dt);
+}
+
+void FairingWindow::restore(Channel& ch, const Learnt& l) {
+  ch.estimator.restore(l.estimates);
+  ch.mu = l.mu;
+  ch.level = l.level;
+  ch.rest = l.rest;
 }
 
 void FairingWindow::slide(int count) {
@@ -714,7 +757,15 @@ bool FairingWindow::hold_outliers(const Sample& s, double step, Quat& z, Vec3& p
   // Not yet emitted (a lag): a released channel is emitted as measured.
   if (rotation == Verdict::Release) held_[last] &= ~kHeldRotation;
   if (position == Verdict::Release) held_[last] &= ~kHeldPosition;
-  if (rotation == Verdict::Release || position == Verdict::Release) ++counters_.released;
+  if (rotation == Verdict::Release || position == Verdict::Release) {
+    ++counters_.released;
+    // The adaptation learns from the released sample as measured, as if it had never been held.
+    if (linear && before_hold_dt_ >= 0.0) {
+      restore(rot_, rot_before_hold_);
+      restore(pos_, pos_before_hold_);
+      linear_emission_estimate(n_ - 1 - config_.lag, before_hold_dt_);
+    }
+  }
   held = (rotation == Verdict::Hold ? kHeldRotation : 0) | (position == Verdict::Hold ? kHeldPosition : 0);
   return held != 0;
 }

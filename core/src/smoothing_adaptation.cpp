@@ -109,19 +109,19 @@ void MotionNoiseEstimator::update_noise(double length, double dt) {
   const double scale = kChi3Median * std::sqrt(binomial(2 * k, k));  // ‖D^kθ‖ median per unit σ
   const double floor = 1e-300;
   length = std::max(length, floor);
-  if (noise_count_ < static_cast<int>(first_lengths_.size())) {
+  if (e_.noise_count < static_cast<int>(e_.first_lengths.size())) {
     // Exact median of the first values: a sound start for the tracker below.
-    first_lengths_[static_cast<std::size_t>(noise_count_++)] = length;
-    std::array<double, 15> sorted = first_lengths_;
-    log_median_ = std::log(upper_median(std::span(sorted).first(static_cast<std::size_t>(noise_count_))));
+    e_.first_lengths[static_cast<std::size_t>(e_.noise_count++)] = length;
+    std::array<double, 15> sorted = e_.first_lengths;
+    e_.log_median = std::log(upper_median(std::span(sorted).first(static_cast<std::size_t>(e_.noise_count))));
   } else {
     // Stochastic approximation of the median in log space: a step up when above, down when
     // below; its time constant is about 1/(2·step) samples.
     const double step = std::min(0.5, 0.5 * dt / settings_.noise_time_s);
-    log_median_ += std::log(length) > log_median_ ? step : -step;
+    e_.log_median += std::log(length) > e_.log_median ? step : -step;
   }
-  const double sigma = std::exp(log_median_) / scale;
-  noise_var_ = sigma * sigma;
+  const double sigma = std::exp(e_.log_median) / scale;
+  e_.noise_var = sigma * sigma;
 }
 
 double MotionNoiseEstimator::newest_half_fit_of_medians(std::span<const Vec3> zeta) const {
@@ -154,9 +154,9 @@ double MotionNoiseEstimator::motion_floor(double fit_noise) const {
   if (!settings_.motion_floor) return 0.0;
   // Where the window's fit is in (on a full window), motion it measures below the fit's noise is
   // taken as it measures it, but never below its own noise.
-  if (window_fit_noise_gain_ > 0.0 && window_ready_) {
-    const double window_noise = noise_var_ * window_fit_noise_gain_;
-    return std::min(fit_noise, std::max(window_noise, window_mean_square_ - window_noise));
+  if (window_fit_noise_gain_ > 0.0 && e_.window_ready) {
+    const double window_noise = e_.noise_var * window_fit_noise_gain_;
+    return std::min(fit_noise, std::max(window_noise, e_.window_mean_square - window_noise));
   }
   return fit_noise;
 }
@@ -167,7 +167,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
   if (!(dt > 0.0)) return false;
   const bool was_ready = ready();
   // The rest test's line is taken on a full window only: after a restart its average starts afresh.
-  if (n1 < line_span_ - 1) line_ready_ = window_ready_ = false;
+  if (n1 < line_span_ - 1) e_.line_ready = e_.window_ready = false;
   bool refreshed = false;
   if (n1 >= k - 1 + 1) {
     // D^kθ at the newest = D^{k−1} of the newest k differences.
@@ -179,21 +179,21 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
     update_noise(d.norm(), dt);
   }
   // The noise each fit lets through, at the noise estimate just updated.
-  const double fit_noise = noise_var_ * fit_noise_gain_;
-  const double short_noise = noise_var_ * short_fit_noise_gain_;
+  const double fit_noise = e_.noise_var * fit_noise_gain_;
+  const double short_noise = e_.noise_var * short_fit_noise_gain_;
   // The fit is taken at most kMotionRefreshes times per motion_time_s (every 4 ms by default):
   // the estimate averages over motion_time_s anyway, and fits a few samples apart share nearly
   // all their samples, so at 1 kHz three fits in four would add nothing but their cost (a
   // quarter of the engine's). At rates up to kMotionRefreshes / motion_time_s every sample fits.
   if (span_ > 0 && n1 >= span_ - 1) {
-    motion_pending_s_ += dt;
+    e_.motion_pending_s += dt;
     // (Less a rounding's worth: four steps of 1 ms may add up to just under 4 ms.)
-    if (!motion_ready_ || motion_pending_s_ >= (1.0 - 1e-9) * settings_.motion_time_s / kMotionRefreshes) {
+    if (!e_.motion_ready || e_.motion_pending_s >= (1.0 - 1e-9) * settings_.motion_time_s / kMotionRefreshes) {
       const Vec3 d = weighted_vector_sum(0, span_ - 1, [&](int j) { return fit_[static_cast<std::size_t>(j)]; },
                                          zeta.subspan(static_cast<std::size_t>(n1 - (span_ - 1))));
       const double sample = d.squaredNorm() / 3.0;
-      const double alpha = motion_ready_ ? 1.0 - std::exp(-motion_pending_s_ / settings_.motion_time_s) : 1.0;
-      mean_square_ += alpha * (sample - mean_square_);
+      const double alpha = e_.motion_ready ? 1.0 - std::exp(-e_.motion_pending_s / settings_.motion_time_s) : 1.0;
+      e_.mean_square += alpha * (sample - e_.mean_square);
       if (short_span_ > 0) {
         // The fast part's fit on the newest half span and on the half before it, the smaller of
         // the two: an outlier sits in one of them, a shake in both.
@@ -203,7 +203,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
           return v.squaredNorm() / 3.0;
         };
         const double fast = std::min(half_fit(0), half_fit(short_span_));
-        short_mean_square_ += alpha * (fast - short_mean_square_);
+        e_.short_mean_square += alpha * (fast - e_.short_mean_square);
       }
       // A motion starting: the average would take motion_time_s to see it, smoothing the start
       // of the motion as hard as what came before. A fit that stands over the onset threshold
@@ -212,10 +212,10 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
       // kMotionOnsetFactor times the motion's (or the noise's, if larger). A single outlier's fit
       // is largest as it enters the span and shrinks after; where it grows again (towards the
       // span's centre) it stands at most a quarter as high.
-      const double onset = at_rest_ ? kRestOnsetFactor * fit_noise
-                                    : fit_noise + kMotionOnsetFactor * std::max(mean_square_ - fit_noise, fit_noise);
+      const double onset = e_.at_rest ? kRestOnsetFactor * fit_noise
+                                    : fit_noise + kMotionOnsetFactor * std::max(e_.mean_square - fit_noise, fit_noise);
       const bool over = sample > onset;
-      if (over && onset_over_ && sample > onset_last_) {
+      if (over && e_.onset_over && sample > e_.onset_last) {
         // The long fit sees a motion starting at its newest end only dimly (its m-th derivative
         // is taken at the span's centre); the newest half span sees it sooner, and counts where
         // it stands clear of its noise. On the running median, so that outliers (two of them
@@ -225,42 +225,42 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
           const double newest = newest_half_fit_of_medians(zeta);
           if (newest > kOnsetSizeFactor * short_noise) taken = std::max(taken, newest - short_noise + fit_noise);
         }
-        mean_square_ = std::max(mean_square_, taken);
+        e_.mean_square = std::max(e_.mean_square, taken);
       }
-      onset_over_ = over;
-      onset_last_ = sample;
+      e_.onset_over = over;
+      e_.onset_last = sample;
       const bool full = n1 >= line_span_ - 1;
       if (settings_.motion_floor && window_fit_noise_gain_ > 0.0 && full) {
         const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return window_fit_[static_cast<std::size_t>(j)]; },
                                            zeta.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
         const double slow = v.squaredNorm() / 3.0;
-        window_mean_square_ = window_ready_ ? window_mean_square_ + alpha * (slow - window_mean_square_) : slow;
-        window_ready_ = true;
+        e_.window_mean_square = e_.window_ready ? e_.window_mean_square + alpha * (slow - e_.window_mean_square) : slow;
+        e_.window_ready = true;
       }
       if (settings_.motion_floor && settings_.rest_threshold > 0.0 && full) {
         const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return line_[static_cast<std::size_t>(j)]; },
                                            zeta.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
         const double slope = v.squaredNorm() / 3.0;
-        line_mean_square_ = line_ready_ ? line_mean_square_ + alpha * (slope - line_mean_square_) : slope;
-        line_ready_ = true;
+        e_.line_mean_square = e_.line_ready ? e_.line_mean_square + alpha * (slope - e_.line_mean_square) : slope;
+        e_.line_ready = true;
       }
-      motion_ready_ = true;
-      motion_pending_s_ = 0.0;
+      e_.motion_ready = true;
+      e_.motion_pending_s = 0.0;
       refreshed = true;
     }
   }
-  if (motion_ready_) {
+  if (e_.motion_ready) {
     const double threshold = settings_.rest_threshold;
-    const double line_noise = noise_var_ * line_noise_gain_;
-    at_rest_ = settings_.motion_floor && threshold > 0.0 && line_ready_ &&
-               line_mean_square_ < (at_rest_ ? kRestLeaveFactor : 1.0) * threshold * line_noise;
-    if (at_rest_)
-      motion_var_ = mean_square_ < threshold * fit_noise ? 0.0 : mean_square_ - fit_noise;
+    const double line_noise = e_.noise_var * line_noise_gain_;
+    e_.at_rest = settings_.motion_floor && threshold > 0.0 && e_.line_ready &&
+               e_.line_mean_square < (e_.at_rest ? kRestLeaveFactor : 1.0) * threshold * line_noise;
+    if (e_.at_rest)
+      e_.motion_var = e_.mean_square < threshold * fit_noise ? 0.0 : e_.mean_square - fit_noise;
     else
-      motion_var_ = std::max(motion_floor(fit_noise), mean_square_ - fit_noise);
+      e_.motion_var = std::max(motion_floor(fit_noise), e_.mean_square - fit_noise);
     // The fast part counts where it stands clear of the noise its fit lets through.
-    if (short_span_ > 0 && short_mean_square_ > kFastMotionFactor * short_noise)
-      motion_var_ = std::max(motion_var_, short_mean_square_ - short_noise);
+    if (short_span_ > 0 && e_.short_mean_square > kFastMotionFactor * short_noise)
+      e_.motion_var = std::max(e_.motion_var, e_.short_mean_square - short_noise);
   }
   return refreshed || ready() != was_ready;
 }

@@ -97,7 +97,7 @@ void BM_DefaultsAtRest(benchmark::State& state) {
 }
 BENCHMARK(BM_DefaultsAtRest)->ArgNames({"rest_line"})->Arg(1)->Arg(0);
 
-// The defaults with a lag of one sample, with the outlier guard (on by default with a lag,
+// The defaults with a lag of one sample, with the outlier guard (on by default,
 // outlier_guard.hpp) and without it; with positions, both channels guarded.
 void BM_DefaultsWithLag(benchmark::State& state) {
   WindowConfig c;

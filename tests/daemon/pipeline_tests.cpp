@@ -657,18 +657,18 @@ TEST(Pipeline, AStillTrackerIsReportedAtRestAndAveragedOverSeconds) {
   }
 }
 
-// The still tracker with three samples thrown 0.2 rad off: with `lag = 1` the engine holds each
-// (the outlier guard is on by default with a lag) and the stats say so; at lag 0 it is off.
+// The still tracker with three samples thrown 0.2 rad off: the engine holds each (the outlier
+// guard is on by default) and the stats say so; `outlier_threshold = 0` holds none.
 TEST(Pipeline, OutliersHeldByTheEngineReachTheStats) {
   ScratchDir dir;
   const std::vector<Sample> still =
       still_tracker([](int k) { return k == 200 || k == 350 || k == 500 ? Vec3(0.2, 0.0, 0.0) : Vec3::Zero(); });
   write_imu_log(dir / "in.pflog", still);
-  for (const std::string lag : {"lag = 1\n", "lag = 0\n"}) {
-    SCOPED_TRACE(lag);
-    const StreamStats st = run_to_end(parse_config(replayed_tracker(dir / "in.pflog", lag), "/virtual/outliers.toml"));
+  for (const std::string keys : {"lag = 1\n", "lag = 0\n", "outlier_threshold = 0\n"}) {
+    SCOPED_TRACE(keys);
+    const StreamStats st = run_to_end(parse_config(replayed_tracker(dir / "in.pflog", keys), "/virtual/outliers.toml"));
     EXPECT_EQ(st.emitted, still.size());
-    EXPECT_EQ(st.outliers_held, lag == "lag = 1\n" ? 3u : 0u);
+    EXPECT_EQ(st.outliers_held, keys == "outlier_threshold = 0\n" ? 0u : 3u);
     EXPECT_EQ(st.outliers_released, 0u);
   }
 }

@@ -73,8 +73,10 @@ struct WindowConfig {
   GateConfig gate;
   // A lone sample further from the prediction of the ones before it than this many times the
   // median of that distance, right after an ordinary one, is held at the prediction
-  // (outlier_guard.hpp); 0: off. Unset: kDefaultOutlierThreshold with a lag, off without one
-  // (at lag 0 an outlier and a sudden motion's first sample look alike until it is emitted).
+  // (outlier_guard.hpp); 0: off. At lag 0 its pose is emitted as measured (an outlier and a
+  // sudden motion's first sample look alike until the next sample), and the prediction takes
+  // its place for the poses after it. Unset: kDefaultOutlierThreshold, but off for an iterative
+  // solver at lag 0 (which would emit the held sample at the prediction).
   std::optional<double> outlier_threshold;
   // Samples with a gyroscope reading (kHasGyro) put the smoothness on the orientation's angular
   // velocity minus the gyro's (gyro_aiding.hpp); linear solver, no horizon. Up to
@@ -82,9 +84,10 @@ struct WindowConfig {
   GyroAidingSettings gyro;
 };
 
-// The outlier guard's threshold where the window has a lag and none is given.
+// The outlier guard's threshold where none is given.
 inline constexpr double kDefaultOutlierThreshold = 8.0;
-// The threshold in use: given, or the default (kDefaultOutlierThreshold with a lag, 0 without).
+// The threshold in use: given, or the default (kDefaultOutlierThreshold; 0 for an iterative
+// solver at lag 0).
 double outlier_threshold(const WindowConfig& config);
 
 // Largest accepted smoothing weight μ (see validate()).
@@ -168,17 +171,30 @@ class FairingWindow {
     // At rest (adapted): the line through the samples since the rest began, its newest
     // coordinate (the sum of the increments since then) and time, whether the channel is at
     // rest now, the line's weight in the output, and whether the line is straight.
-    RestLine rest_line;
-    Vec3 rest_theta = Vec3::Zero();
-    double rest_time = 0.0;
-    bool resting = false;
-    double rest_weight = 0.0;
-    bool rest_averaged = false;
+    struct Rest {
+      RestLine line;
+      Vec3 theta = Vec3::Zero();
+      double time = 0.0;
+      bool resting = false;
+      double weight = 0.0;
+      bool averaged = false;
+    } rest;
   };
+  // What a channel's adaptation had learnt before a held sample went in: put back when the next
+  // sample releases it, and the released sample learnt from as measured, so that a released
+  // sample leaves the stream as if it had never been held. Fixed size: no allocation.
+  struct Learnt {
+    MotionNoiseEstimator::Estimates estimates;
+    double mu = 0.0, level = 0.0;
+    Channel::Rest rest;
+  };
+  static Learnt learnt(const Channel& ch) { return {ch.estimator.estimates(), ch.mu, ch.level, ch.rest}; }
+  static void restore(Channel& ch, const Learnt& l);
 
   // held_'s bits: which channel of a sample holds the prediction.
   static constexpr char kHeldRotation = 1, kHeldPosition = 2;
   bool hold_outliers(const Sample& s, double step, Quat& z, Vec3& p, char& held);
+  void put_held(const Quat& z, const Vec3& p, char held, double dt);
   void append(const Sample& s);
   bool gyro_aided(const Sample& s) const;
   // What the rotation rows apply to: the measured increments ζ, or with a gyro their residual.
@@ -244,6 +260,10 @@ class FairingWindow {
   EmissionRow fill_row_;             // scratch: the row of a window still filling
   Channel rot_, pos_;
   OutlierGuard rot_guard_, pos_guard_;
+  // Before the newest sample was held: both channels' adaptation, and the step it came after
+  // (valid while before_hold_dt_ >= 0).
+  Learnt rot_before_hold_, pos_before_hold_;
+  double before_hold_dt_ = -1.0;
   GyroAiding gyro_;
   // The rotation's adaptation while gyro-aided: the residual is slow, so its motion is fitted
   // over the whole window (a shorter fit passes so much noise that it would pass for motion).

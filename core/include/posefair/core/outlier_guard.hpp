@@ -13,9 +13,10 @@
 // and the sample after a held one tells an outlier from a motion's start or a jump that stays:
 // after an outlier it lands near the line, after a start nearer the held measurement than the
 // line, and the held sample is released (taken back into the window as measured, and emitted so
-// if the window's lag has not emitted it yet). So with a lag the guard costs a sudden motion
-// nothing; with none, the held first sample of a motion that starts at once is emitted at the
-// prediction, which is why the engine leaves it off by default at lag 0 (fairing_window.hpp).
+// if the window's lag has not emitted it yet; the window's adaptation learns from it as if it had
+// never been held). So with a lag the guard costs a sudden motion nothing. At lag 0 a held sample
+// is emitted before the next one comes, so the window emits it as measured and holds it only for
+// the poses after it (fairing_window.hpp): a sudden motion costs nothing there either.
 // The median is the stream's own (its noise and how well its motion is predicted), so the
 // threshold needs no units; below a small floor nothing is held (a still, quantised stream whose
 // median is zero would otherwise hold every least bit it moves).

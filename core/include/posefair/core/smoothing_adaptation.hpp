@@ -109,10 +109,38 @@ class MotionNoiseEstimator {
   // averaged as the motion, counts where it stands this many times over its noise.
   static constexpr double kFastMotionFactor = 4.0;
 
-  bool ready() const { return noise_count_ > 0 && motion_ready_; }
-  bool at_rest() const { return at_rest_; }
-  double noise_variance() const { return noise_var_; }    // σ², per component, per sample
-  double motion_variance() const { return motion_var_; }  // d², per component, per sample^(2m)
+  // What the estimator has learnt from the stream (its weights aside, which configure() sets):
+  // small and copyable, so that a window can put it back as it was before a sample it took
+  // back (fairing_window.hpp, outliers).
+  struct Estimates {
+    // Noise: the median of ‖D^{m+2}θ‖, exact over the first values, then tracked.
+    std::array<double, 15> first_lengths{};
+    int noise_count = 0;
+    double log_median = 0.0;
+    double noise_var = 0.0;
+    // Motion: the fit's mean square, the stream time since it was last taken, and d².
+    double mean_square = 0.0;
+    bool motion_ready = false;
+    double motion_pending_s = 0.0;
+    double motion_var = 0.0;
+    // The mean squares of the fast part's fit (the smaller of two neighbouring half spans), the
+    // slow part's (over the window) and the rest test's line.
+    double short_mean_square = 0.0;
+    double window_mean_square = 0.0;
+    bool window_ready = false;
+    double line_mean_square = 0.0;
+    bool line_ready = false;
+    bool at_rest = false;
+    bool onset_over = false;  // the last fit stood over the onset threshold
+    double onset_last = 0.0;  // the last fit's mean square
+  };
+  const Estimates& estimates() const { return e_; }
+  void restore(const Estimates& e) { e_ = e; }
+
+  bool ready() const { return e_.noise_count > 0 && e_.motion_ready; }
+  bool at_rest() const { return e_.at_rest; }
+  double noise_variance() const { return e_.noise_var; }    // σ², per component, per sample
+  double motion_variance() const { return e_.motion_var; }  // d², per component, per sample^(2m)
   int span() const { return span_; }
 
  private:
@@ -129,38 +157,20 @@ class MotionNoiseEstimator {
   int span_ = 0;
   std::vector<double> fit_;      // weights on the span's span−1 differences
   double fit_noise_gain_ = 0.0;  // Σ of the fit's squared weights on θ
-  // The motion's fast part: the same fit over half the span (0: none), its mean square (of the
-  // smaller of two neighbouring half spans), and its noise gain.
+  // The motion's fast part: the same fit over half the span (0: none), and its noise gain.
   int short_span_ = 0;
   std::vector<double> short_fit_;
   double short_fit_noise_gain_ = 0.0;
-  double short_mean_square_ = 0.0;
-  // Noise: the median of ‖D^{m+2}θ‖, exact over the first values, then tracked.
-  std::array<double, 15> first_lengths_{};
-  int noise_count_ = 0;
-  double log_median_ = 0.0;
-  double noise_var_ = 0.0;
-  // Motion.
-  double mean_square_ = 0.0;
-  bool motion_ready_ = false;
-  double motion_pending_s_ = 0.0;  // stream time since the fit was last taken
-  double motion_var_ = 0.0;
   // The motion's slow part: the same fit over the whole window (line_span_ samples; none where
-  // that spans more than twice motion_span_s), its mean square, and its noise gain.
+  // that spans more than twice motion_span_s), and its noise gain.
   std::vector<double> window_fit_;
   double window_fit_noise_gain_ = 0.0;
-  double window_mean_square_ = 0.0;
-  bool window_ready_ = false;
   // Rest: the slope of a line through the newest line_span_ samples (weights on their
-  // differences, as fit_), its mean square, and Σ of its squared weights on θ.
+  // differences, as fit_), and Σ of its squared weights on θ.
   int line_span_ = 0;
   std::vector<double> line_;
   double line_noise_gain_ = 0.0;
-  double line_mean_square_ = 0.0;
-  bool line_ready_ = false;
-  bool at_rest_ = false;
-  bool onset_over_ = false;   // the last fit stood over the onset threshold
-  double onset_last_ = 0.0;   // the last fit's mean square
+  Estimates e_;
 };
 
 // The smoothing level (a real index into rows, ordered from least to most smoothing) with the
