@@ -120,8 +120,10 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
                 static_cast<unsigned long long>(r.gate.dropped()), static_cast<unsigned long long>(r.gate.rejected()));
     const double threshold = outlier_threshold(c);
     if (threshold > 0.0)
-      std::printf("outliers %llu held at the prediction (threshold %g), %llu of them released as a motion's start\n",
-                  static_cast<unsigned long long>(r.counters.held), threshold, static_cast<unsigned long long>(r.counters.released));
+      std::printf("outliers %llu held at the prediction (threshold %g%s), %llu of them released as a motion's start\n",
+                  static_cast<unsigned long long>(r.counters.held), threshold,
+                  c.lag == 0 ? "; at lag 0 each emitted as measured, held for the poses after it" : "",
+                  static_cast<unsigned long long>(r.counters.released));
     else
       std::printf("outliers not guarded (%s)\n", c.outlier_threshold ? "--outlier-threshold 0" : "an iterative solver at lag 0; --outlier-threshold turns the guard on");
     print_deviation_line(r.max_dist_r, in.has_position(), r.max_deviation_t);

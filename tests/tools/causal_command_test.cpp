@@ -1,6 +1,7 @@
 // `posefair fair --causal` runs the real-time engine over a file exactly as the daemon will:
 // its output must equal the engine called directly, sample for sample, bit for bit.
 #include <filesystem>
+#include <random>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -8,6 +9,7 @@
 #include "cli_runner.hpp"
 #include "posefair/core/causal_fairing.hpp"
 #include "posefair/core/fairing_window.hpp"
+#include "posefair/core/so3.hpp"
 #include "posefair/core/synthetic_motion.hpp"
 #include "posefair/formats/pose_file.hpp"
 
@@ -93,6 +95,32 @@ TEST(CausalCommand, EqualsTheEngineCalledDirectly) {
       }
     }
   }
+}
+
+// A still stream at 100 Hz with three samples thrown 0.2 rad off: the outlier guard (on by
+// default, docs/engine.md "Outliers") holds each, and the run says how it was guarded.
+TEST(CausalCommand, SaysWhatTheOutlierGuardHeld) {
+  ScratchDir dir;
+  PoseSequence in;
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  for (int i = 0; i < 500; ++i) {
+    in.time.push_back(i * 0.01);
+    const Vec3 off = i == 200 || i == 300 || i == 400 ? Vec3(0.2, 0.0, 0.0) : Vec3::Zero();
+    in.orientation.push_back(so3::from_rotation_vector(off + Vec3(noise(rng), noise(rng), noise(rng))));
+  }
+  const auto in_path = dir / "in.csv";
+  formats::write_pose_file(in_path, formats::make_csv(in), in);
+  const std::string run = "fair --causal '" + in_path.string() + "' -o '" + (dir / "o.csv").string() + "'";
+  auto r = run_posefair(run, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("outliers 3 held at the prediction (threshold 8; at lag 0 each emitted as measured"));
+  r = run_posefair(run + " --lag 1", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("outliers 3 held at the prediction (threshold 8), 0 of them released"));
+  r = run_posefair(run + " --outlier-threshold 0", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("outliers not guarded (--outlier-threshold 0)"));
 }
 
 TEST(CausalCommand, CutoffNeedsTheFileRateAndWindowOptionsNeedCausal) {
