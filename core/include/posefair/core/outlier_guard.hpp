@@ -8,7 +8,7 @@
 // The guard predicts each sample from a line through the few before it (least squares on the
 // sum of their increments against their real times), and tracks the median of how far samples
 // land from that prediction. A sample further than `threshold` times that median is held at the
-// prediction if the sample before it was ordinary (within twice the median). A sudden motion
+// prediction if the sample before it was ordinary (within three times the median). A sudden motion
 // mostly builds up over a sample or two, which puts the sample before it off the line already;
 // and the sample after a held one tells an outlier from a motion's start or a jump that stays:
 // after an outlier it lands near the line, after a start nearer the held measurement than the
@@ -74,7 +74,7 @@ class OutlierGuard {
   int count_ = 0;
   double log_median_ = 0.0;
   int seen_ = 0;  // distances seen, up to kOutlierWarmUp
-  bool ordinary_before_ = false;  // the sample before landed within twice the median
+  bool ordinary_before_ = false;  // the sample before landed within kOrdinary times the median
   bool held_before_ = false;      // the sample before was held; held_offset_: its measurement from the prediction
   Vec3 held_offset_ = Vec3::Zero();
 };
