@@ -14,7 +14,7 @@ namespace {
 // median).
 constexpr double kRate = 0.025;
 // A sample is ordinary within three times the median (Gaussian noise lands further about once
-// in 10 000 samples). At twice the median (its 95th percentile) one outlier in twenty came after
+// in 10 000 samples). At twice the median (about its 97.5th percentile) one outlier in twenty came after
 // a sample that was not ordinary and was taken; the rule's point, that a motion building up over
 // a sample or two puts the sample before off the line already, holds at either (on BROAD's
 // optical stream both hold only samples the next one releases: 315 at twice, 452 at three times).
