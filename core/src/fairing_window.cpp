@@ -161,8 +161,13 @@ double cutoff_for_smoothing(double mu, double rate_hz, int order) {
 
 double outlier_threshold(const WindowConfig& config) {
   if (config.outlier_threshold) return *config.outlier_threshold;
-  // At lag 0 only the linear solver can emit a held sample as the measurement (push, put_held).
-  return config.lag > 0 || config.solver == WindowSolver::Linear ? kDefaultOutlierThreshold : 0.0;
+  return config.lag > 0 || emits_held_as_measured(config) ? kDefaultOutlierThreshold : 0.0;
+}
+
+// Only the linear solver can emit a held sample as measured and then put the prediction in its
+// place (push, put_held): it keeps no estimate between samples.
+bool emits_held_as_measured(const WindowConfig& config) {
+  return config.lag == 0 && config.solver == WindowSolver::Linear;
 }
 
 FairingWindow::Channel::Channel(int capacity, int order) : fixed(make_emission_row(capacity)), estimator(capacity, order) {}
@@ -617,7 +622,7 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   // motion's first sample looks just like an outlier: so it is emitted as the window would
   // emit the measurement, and the prediction takes its place only after (put_held below), for
   // the poses after it and what the adaptation learns.
-  const bool emit_measured = hold && config_.lag == 0 && linear;
+  const bool emit_measured = hold && emits_held_as_measured(config_);
   if (hold) {
     ++counters_.held;
     rot_before_hold_ = learnt(rot_);

@@ -86,9 +86,12 @@ struct WindowConfig {
 
 // The outlier guard's threshold where none is given.
 inline constexpr double kDefaultOutlierThreshold = 8.0;
-// The threshold in use: given, or the default (kDefaultOutlierThreshold; 0 for an iterative
-// solver at lag 0).
+// The threshold in use: given, or the default (kDefaultOutlierThreshold; 0 where a held sample
+// would be emitted at the prediction at lag 0: an iterative solver).
 double outlier_threshold(const WindowConfig& config);
+// Whether a held sample's pose is emitted as measured (held only for the poses after it): at lag 0
+// with the linear solver. Otherwise it is emitted at the prediction unless released first.
+bool emits_held_as_measured(const WindowConfig& config);
 
 // Largest accepted smoothing weight μ (see validate()).
 inline constexpr double kMaxSmoothing = 1e10;
