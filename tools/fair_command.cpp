@@ -88,6 +88,7 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
     WindowConfig at_file_rate = c;
     if (at_file_rate.rate_hz == 0.0) at_file_rate.rate_hz = rate;
     validate(at_file_rate);
+    validate(c);  // as the engine will run it: an iterative solver's cutoff needs --rate
   } catch (const std::invalid_argument& e) {
     std::cerr << "posefair fair: " << e.what() << "\n";
     return exit_code(ErrorKind::Usage);

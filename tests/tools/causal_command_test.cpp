@@ -139,6 +139,17 @@ TEST(CausalCommand, CutoffNeedsTheFileRateAndWindowOptionsNeedCausal) {
   r = run_posefair("fair --causal '" + in_path.string() + "' -o '" + (dir / "o.csv").string() + "' --cutoff 4 --lag 2", dir);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("lag 2 (20 ms)"));
+  // An iterative solver takes its smoothing at construction: a cutoff needs --rate (this aborted
+  // on an uncaught exception before).
+  r = run_posefair("fair --causal '" + in_path.string() + "' -o '" + (dir / "o.csv").string() +
+                       "' --solver gauss-newton --window 32 --cutoff 5",
+                   dir);
+  EXPECT_EQ(r.exit_code, 64) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("rate_hz"));
+  r = run_posefair("fair --causal '" + in_path.string() + "' -o '" + (dir / "o.csv").string() +
+                       "' --solver gauss-newton --window 32 --cutoff 5 --rate 100",
+                   dir);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
 TEST(BenchQuality, QuickRunTunesOnTrainingSeedsAndReportsEveryRow) {
