@@ -723,9 +723,10 @@ void FairingWindow::slide(int count) {
   n_ -= count;
 }
 
-// A lone outlier (outlier_guard.hpp) is held at the prediction: z and p, the values the
-// window takes instead. A held sample that the next one shows to be a motion's start is taken
-// back into the window as measured. step: how long after the window's newest sample s was
+// An outlier (outlier_guard.hpp; alone, or up to kMaxHeldRun in a row) is held at the
+// prediction: z and p, the values the window takes instead. A held sample that the next one shows
+// to be a motion's start is taken back into the window as measured (only the newest held sample
+// can be: the adaptation's copy is from just before it). step: how long after the window's newest sample s was
 // taken (0: it starts a window).
 bool FairingWindow::hold_outliers(const Sample& s, double step, Quat& z, Vec3& p, char& held) {
   using Verdict = OutlierGuard::Verdict;

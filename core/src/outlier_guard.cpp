@@ -27,7 +27,9 @@ OutlierGuard::Verdict OutlierGuard::check(double step, Vec3& increment) {
   if (threshold_ <= 0.0) return Verdict::Take;
   Verdict verdict = Verdict::Take;
   const bool held_before = held_before_;
+  const int held_run = held_run_;
   held_before_ = false;
+  held_run_ = 0;
   if (count_ >= 2 && step > 0.0) {
     // The points in the chart of the newest one (at time 0, coordinate 0), going back.
     double u = 0.0, su = 0.0, suu = 0.0;
@@ -51,7 +53,8 @@ OutlierGuard::Verdict OutlierGuard::check(double step, Vec3& increment) {
       const double distance = (increment - predicted).norm() / scale_;
       const double median = std::exp(log_median_);
       const bool warm = seen_ >= kOutlierWarmUp;
-      const bool held_now = warm && distance > kOutlierFloor && distance > threshold_ * median && ordinary_before_;
+      const bool held_now = warm && distance > kOutlierFloor && distance > threshold_ * median &&
+                            (ordinary_before_ || (held_before && held_run < kMaxHeldRun));
       ordinary_before_ = warm && distance <= kOrdinary * median;
       const double log_distance = std::log(std::max(distance, 1e-300));
       if (warm) {
@@ -70,6 +73,7 @@ OutlierGuard::Verdict OutlierGuard::check(double step, Vec3& increment) {
       } else if (held_now) {
         held_offset_ = increment - predicted;
         held_before_ = true;
+        held_run_ = held_run + 1;
         increment = predicted;
         verdict = Verdict::Hold;
       }

@@ -117,7 +117,7 @@ struct WindowCounters {
   std::uint64_t restarts = 0;   // windows restarted after a gap, a change of rate, or for samples with/without positions or gyro
   std::uint64_t rate_changes = 0;  // of those, for a change of the measured rate (the window restarted at the new one)
   std::uint64_t gyro_bridged = 0;  // readings missing from a gyro-aided window, bridged without a restart
-  std::uint64_t held = 0;          // lone outliers held at the prediction (rotation, position or both)
+  std::uint64_t held = 0;          // outliers held at the prediction (rotation, position or both)
   std::uint64_t released = 0;      // of those, taken back: the next sample showed a motion starting
 };
 

@@ -1,6 +1,7 @@
 #pragma once
-// A lone outlier: one sample far from where the samples before it were going (an optical
-// tracker's reflection taken for a marker for one frame, a value corrupted but still parsed).
+// A lone outlier, or a short burst of them: a sample far from where the samples before it were
+// going (an optical tracker's reflection taken for a marker for a frame or two, a value corrupted
+// but still parsed).
 // Smoothing cannot hide one: the window spreads it over its neighbours, and it breaks the rest
 // test, so a still stream with 1% of its samples 0.2 rad off gets 75% more error than a fixed
 // 1 Hz cutoff (docs/engine.md, "Outliers").
@@ -11,8 +12,9 @@
 // prediction if the sample before it was ordinary (within three times the median). A sudden motion
 // mostly builds up over a sample or two, which puts the sample before it off the line already;
 // and the sample after a held one tells an outlier from a motion's start or a jump that stays:
-// after an outlier it lands near the line, after a start nearer the held measurement than the
-// line, and the held sample is released (taken back into the window as measured, and emitted so
+// after an outlier it lands near the line (or, in a burst of outliers, far from both the line and
+// the held one, and is held too, up to kMaxHeldRun in a row), after a start nearer the held
+// measurement than the line, and the held sample is released (taken back into the window as measured, and emitted so
 // if the window's lag has not emitted it yet; the window's adaptation learns from it as if it had
 // never been held). So with a lag the guard costs a sudden motion nothing. At lag 0 a held sample
 // is emitted before the next one comes, so the window emits it as measured and holds it only for
@@ -36,6 +38,9 @@ inline constexpr int kOutlierWarmUp = 20;
 // Below this distance from the prediction (rad of rotation angle, or position units) nothing is
 // held: under any tracker's noise, and smaller than any outlier worth a held sample.
 inline constexpr double kOutlierFloor = 1e-4;
+// The most samples held in a row (a tracker glitching for a few frames, each sample thrown its
+// own way); the sample after them is taken. Only the newest held sample can be released.
+inline constexpr int kMaxHeldRun = 3;
 // The largest threshold accepted (multiples of the median).
 inline constexpr double kMaxOutlierThreshold = 1000.0;
 
@@ -49,7 +54,7 @@ class OutlierGuard {
 
   enum class Verdict {
     Take,
-    Hold,     // a lone outlier: increment is replaced by the prediction
+    Hold,     // an outlier (alone, or in a burst): increment is replaced by the prediction
     Release,  // the sample before was held, but this one says a motion started: it lands nearer
               // the held measurement than the line. Take the held sample back as measured;
               // increment is made relative to it.
@@ -62,6 +67,7 @@ class OutlierGuard {
   void restart() {
     count_ = 0;
     ordinary_before_ = held_before_ = false;
+    held_run_ = 0;
   }
 
  private:
@@ -77,6 +83,7 @@ class OutlierGuard {
   bool ordinary_before_ = false;  // the sample before landed within kOrdinary times the median
   bool held_before_ = false;      // the sample before was held; held_offset_: its measurement from the prediction
   Vec3 held_offset_ = Vec3::Zero();
+  int held_run_ = 0;              // samples held in a row, up to the one before
 };
 
 }  // namespace posefair
