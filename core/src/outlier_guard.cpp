@@ -30,6 +30,11 @@ OutlierGuard::Verdict OutlierGuard::check(double step, Vec3& increment) {
   const int held_run = held_run_;
   held_before_ = false;
   held_run_ = 0;
+  // A released sample is a step the line runs through for the next kOutlierFitPoints − 1
+  // samples; its prediction overshoots the stream meanwhile, so a sample far from it is no sign of
+  // an outlier (the end of a burst that held one value, which with a lag would go out held).
+  const bool settled = settling_ == 0;
+  if (settling_ > 0) --settling_;
   if (count_ >= 2 && step > 0.0) {
     // The points in the chart of the newest one (at time 0, coordinate 0), going back.
     double u = 0.0, su = 0.0, suu = 0.0;
@@ -54,7 +59,7 @@ OutlierGuard::Verdict OutlierGuard::check(double step, Vec3& increment) {
       const double median = std::exp(log_median_);
       const bool warm = seen_ >= kOutlierWarmUp;
       const bool held_now = warm && distance > kOutlierFloor && distance > threshold_ * median &&
-                            (ordinary_before_ || (held_before && held_run < kMaxHeldRun));
+                            ((ordinary_before_ && settled) || (held_before && held_run < kMaxHeldRun));
       ordinary_before_ = warm && distance <= kOrdinary * median;
       const double log_distance = std::log(std::max(distance, 1e-300));
       if (warm) {
@@ -70,6 +75,7 @@ OutlierGuard::Verdict OutlierGuard::check(double step, Vec3& increment) {
         increment_[static_cast<std::size_t>(previous)] += held_offset_;
         increment -= held_offset_;
         verdict = Verdict::Release;
+        settling_ = kOutlierFitPoints - 1;
       } else if (held_now) {
         held_offset_ = increment - predicted;
         held_before_ = true;

@@ -14,9 +14,11 @@
 // and the sample after a held one tells an outlier from a motion's start or a jump that stays:
 // after an outlier it lands near the line (or, in a burst of outliers, far from both the line and
 // the held one, and is held too, up to kMaxHeldRun in a row), after a start nearer the held
-// measurement than the line, and the held sample is released (taken back into the window as measured, and emitted so
-// if the window's lag has not emitted it yet; the window's adaptation learns from it as if it had
-// never been held). So with a lag the guard costs a sudden motion nothing. At lag 0 a held sample
+// measurement than the line, and the held sample is released (taken back into the window as
+// measured, and emitted so if the window's lag has not emitted it yet; the window's adaptation
+// learns from it as if it had never been held). A released sample is a step in the line for the
+// samples after it, and nothing new is held until it has left the line's points. So with a lag
+// the guard costs a sudden motion nothing. At lag 0 a held sample
 // is emitted before the next one comes, so the window emits it as measured and holds it only for
 // the poses after it (fairing_window.hpp): a sudden motion costs nothing there either.
 // The median is the stream's own (its noise and how well its motion is predicted), so the
@@ -68,6 +70,7 @@ class OutlierGuard {
     count_ = 0;
     ordinary_before_ = held_before_ = false;
     held_run_ = 0;
+    settling_ = 0;
   }
 
  private:
@@ -83,7 +86,8 @@ class OutlierGuard {
   bool ordinary_before_ = false;  // the sample before landed within kOrdinary times the median
   bool held_before_ = false;      // the sample before was held; held_offset_: its measurement from the prediction
   Vec3 held_offset_ = Vec3::Zero();
-  int held_run_ = 0;              // samples held in a row, up to the one before
+  int held_run_ = 0;   // samples held in a row, up to the one before
+  int settling_ = 0;   // samples until a released step has left the line's points (nothing new is held)
 };
 
 }  // namespace posefair
