@@ -35,14 +35,14 @@ std::uint32_t FixedRateResampler::flags_between(double t) const {
     if (slot_time_[k] <= t) {
       const std::uint32_t before = slot_flags_[k];
       const std::uint32_t next = have_after ? after : before;
-      std::uint32_t flags = (before | next) & kBridged;
+      std::uint32_t flags = (before | next) & kNotMeasured;
       if ((before & kHasPosition) && (next & kHasPosition)) flags |= kHasPosition;
       return flags;
     }
     after = slot_flags_[k];
     have_after = true;
   }
-  return after & (kBridged | kHasPosition);
+  return after & (kNotMeasured | kHasPosition);
 }
 
 std::size_t FixedRateResampler::push(const FairedPose& stamped, std::span<FairedPose> out) {
@@ -119,7 +119,7 @@ std::size_t FixedRateResampler::push_lerp(const FairedPose& pose, std::span<Fair
   const bool position = (a.flags & kHasPosition) && (pose.flags & kHasPosition);
   lerp_.prepare(a.orientation, position ? a.position : Vec3::Zero(), pose.orientation,
                 position ? pose.position : Vec3::Zero());
-  const std::uint32_t flags = ((a.flags | pose.flags) & kBridged) | (position ? kHasPosition : 0u);
+  const std::uint32_t flags = ((a.flags | pose.flags) & kNotMeasured) | (position ? kHasPosition : 0u);
   const double span = pose.time - a.time;
   std::size_t n = 0;
   while (n < out.size() && n < max_outputs_) {

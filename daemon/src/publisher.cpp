@@ -68,7 +68,7 @@ Publisher::Result Publisher::publish(const RingPose& pose) {
   m.orientation = st.frame.orientation(Quat(pose.q[0], pose.q[1], pose.q[2], pose.q[3]));
   if (pose.flags & kHasPosition) m.position = st.frame.position(Vec3(pose.p[0], pose.p[1], pose.p[2]));
   if (pose.flags & kClamped) m.flags |= kFlagClamped;
-  if (pose.flags & kBridged) m.flags |= kFlagBridged;
+  if (pose.flags & kNotMeasured) m.flags |= kFlagBridged;  // a held outlier's pose too
   // Body rate between consecutive emitted poses: q_prev⁻¹ q = exp(ω dt / 2) in the papers'
   // half-angle convention, so ω = 2 log(q_prev⁻¹ q) / dt (the stream is hemisphere-continuous).
   // dt is the time the samples were taken apart (FairedPose::step): samples read together and

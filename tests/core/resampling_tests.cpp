@@ -287,23 +287,28 @@ TEST(FixedRateResampler, ALongStepRestartsWithoutGridPosesInTheGap) {
 }
 
 TEST(FixedRateResampler, GridPosesBetweenBridgedPosesAreBridgedAndPositionNeedsBoth) {
-  FixedRateResamplerOptions o;
-  o.rate_hz = 1000.0;
-  FixedRateResampler r(o);
-  std::vector<FairedPose> out(r.max_outputs());
-  std::vector<FairedPose> all;
-  for (int i = 0; i < 40; ++i) {
-    std::uint32_t flags = kHasPosition;
-    if (i == 20) flags |= kBridged;
-    if (i >= 30) flags = 0;  // no position from here
-    const std::size_t n = r.push(pose_at(0.01 * i + 0.0003, flags), out);  // knots off the grid
-    all.insert(all.end(), out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n));
-  }
-  ASSERT_GT(all.size(), 300u);
-  for (const FairedPose& g : all) {
-    const bool near_bridged = g.time > 0.1903 && g.time < 0.2103;
-    EXPECT_EQ((g.flags & kBridged) != 0, near_bridged) << "t = " << g.time;
-    EXPECT_EQ((g.flags & kHasPosition) != 0, g.time < 0.2903) << "t = " << g.time;
+  // Bridged across a gap, or a held outlier's pose: either way not made from its own
+  // measurement, and neither is a grid pose next to it.
+  for (const std::uint32_t made : {std::uint32_t{kBridged}, std::uint32_t{kHeld}}) {
+    SCOPED_TRACE(made);
+    FixedRateResamplerOptions o;
+    o.rate_hz = 1000.0;
+    FixedRateResampler r(o);
+    std::vector<FairedPose> out(r.max_outputs());
+    std::vector<FairedPose> all;
+    for (int i = 0; i < 40; ++i) {
+      std::uint32_t flags = kHasPosition;
+      if (i == 20) flags |= made;
+      if (i >= 30) flags = 0;  // no position from here
+      const std::size_t n = r.push(pose_at(0.01 * i + 0.0003, flags), out);  // knots off the grid
+      all.insert(all.end(), out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n));
+    }
+    ASSERT_GT(all.size(), 300u);
+    for (const FairedPose& g : all) {
+      const bool near_made = g.time > 0.1903 && g.time < 0.2103;
+      EXPECT_EQ(g.flags & kNotMeasured, near_made ? made : 0u) << "t = " << g.time;
+      EXPECT_EQ((g.flags & kHasPosition) != 0, g.time < 0.2903) << "t = " << g.time;
+    }
   }
 }
 

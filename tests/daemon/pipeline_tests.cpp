@@ -673,6 +673,33 @@ TEST(Pipeline, OutliersHeldByTheEngineReachTheStats) {
   }
 }
 
+// A held outlier's pose (with a lag: made at the prediction, not from its measurement) goes out
+// flagged `bridged`, as a pose made across a gap does; at lag 0 it goes out as measured, unflagged.
+TEST(Pipeline, AHeldPoseIsFlaggedBridgedOnTheWire) {
+  ScratchDir dir;
+  const std::vector<int> outliers = {200, 350, 500};
+  const std::vector<Sample> still = still_tracker([&](int k) {
+    return std::find(outliers.begin(), outliers.end(), k) != outliers.end() ? Vec3(0.2, 0.0, 0.0) : Vec3::Zero();
+  });
+  write_imu_log(dir / "in.pflog", still);
+  for (const int lag : {1, 0}) {
+    SCOPED_TRACE(::testing::Message() << "lag " << lag);
+    UdpCollector receiver;
+    const std::string text = "[[stream]]\nid = 1\nname = \"tracker\"\nring_capacity = 4096\n"
+                             "[stream.driver]\ntype = \"replay\"\npath = \"" +
+                             (dir / "in.pflog").string() + "\"\ntiming = \"fast\"\n[stream.engine]\nlag = " +
+                             std::to_string(lag) + "\n[[output]]\ndestinations = [\"127.0.0.1:" +
+                             std::to_string(receiver.port()) + "\"]\n";
+    run_to_end(parse_config(text, "/virtual/held.toml"));
+    receiver.drain();
+    std::vector<int> bridged;
+    for (const PoseMessage& m : receiver.messages())
+      if (m.bridged()) bridged.push_back(static_cast<int>(std::lround(m.sample_time * 100.0)));
+    EXPECT_EQ(receiver.messages().size(), still.size());
+    EXPECT_EQ(bridged, lag == 0 ? std::vector<int>{} : outliers);
+  }
+}
+
 // The same receive times: resampled onto a 90 Hz grid, and limited to 100 poses a second. Both
 // place the poses at the times the samples were taken (sampled_clock.hpp), not at their stamps:
 // through knots 1 µs apart the spline's grid poses were radians off, and by the stamps the limit

@@ -43,7 +43,8 @@ class FixedRateResampler {
 
   // Feeds one faired pose (a pose stamped not after the previous one is ignored); writes the grid
   // poses now final to out (at least max_outputs() long) and returns how many. A grid pose is
-  // kBridged when either faired pose around it is, and has a position when both have one.
+  // kBridged or kHeld (kNotMeasured) when either faired pose around it is, and has a position
+  // when both have one.
   std::size_t push(const FairedPose& pose, std::span<FairedPose> out);
   std::size_t max_outputs() const { return max_outputs_; }
   // The most input intervals a grid pose waits for (the added delay in intervals).

@@ -19,8 +19,11 @@ enum SampleFlags : std::uint32_t {
   kHasAccel = 1u << 5,       // accel, m/s^2 (specific force: +g upwards at rest)
   kHasMag = 1u << 6,         // mag, microtesla
   kNoOrientation = 1u << 7,  // raw inertial sample only
-  kHeld = 1u << 8,  // FairedPose only: its measurement was a lone outlier, held at the prediction (outlier_guard.hpp)
+  kHeld = 1u << 8,  // FairedPose only: its measurement was an outlier, held at the prediction (outlier_guard.hpp)
 };
+// A pose not faired from its own measurement: bridged across a gap, or held at the prediction.
+// On the wire both are the flag `bridged` (docs/protocol.md).
+inline constexpr std::uint32_t kNotMeasured = kBridged | kHeld;
 
 struct Sample {
   std::uint32_t stream_id = 0;
