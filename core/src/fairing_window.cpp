@@ -726,8 +726,8 @@ void FairingWindow::slide(int count) {
 // An outlier (outlier_guard.hpp; alone, or up to kMaxHeldRun in a row) is held at the
 // prediction: z and p, the values the window takes instead. A held sample that the next one shows
 // to be a motion's start is taken back into the window as measured (only the newest held sample
-// can be: the adaptation's copy is from just before it). step: how long after the window's newest sample s was
-// taken (0: it starts a window).
+// can be: the adaptation's copy is from just before it). step: how long after the window's
+// newest sample s was taken (0: it starts a window).
 bool FairingWindow::hold_outliers(const Sample& s, double step, Quat& z, Vec3& p, char& held) {
   using Verdict = OutlierGuard::Verdict;
   held = 0;
