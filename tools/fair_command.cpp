@@ -123,7 +123,7 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
     if (threshold > 0.0)
       std::printf("outliers %llu held at the prediction (threshold %g%s), %llu of them released as a motion's start\n",
                   static_cast<unsigned long long>(r.counters.held), threshold,
-                  emits_held_as_measured(c) ? "; at lag 0 each emitted as measured, held for the poses after it" : "",
+                  emits_held_as_measured(c) ? "; at lag 0 each emitted as measured, but the rest of a burst, and held for the poses after it" : "",
                   static_cast<unsigned long long>(r.counters.released));
     else
       std::printf("outliers not guarded (%s)\n", c.outlier_threshold ? "--outlier-threshold 0" : "an iterative solver at lag 0; --outlier-threshold turns the guard on");

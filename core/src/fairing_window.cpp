@@ -621,8 +621,11 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   // At lag 0 a held sample is emitted before the next one can release it, and a sudden
   // motion's first sample looks just like an outlier: so it is emitted as the window would
   // emit the measurement, and the prediction takes its place only after (put_held below), for
-  // the poses after it and what the adaptation learns.
-  const bool emit_measured = hold && emits_held_as_measured(config_);
+  // the poses after it and what the adaptation learns. Not the rest of a burst: each of those
+  // follows a held sample it did not release, which a motion's next sample would have.
+  const bool burst = (!(held & kHeldRotation) || rot_guard_.continues_burst()) &&
+                     (!(held & kHeldPosition) || pos_guard_.continues_burst());
+  const bool emit_measured = hold && emits_held_as_measured(config_) && !burst;
   if (hold) {
     ++counters_.held;
     rot_before_hold_ = learnt(rot_);

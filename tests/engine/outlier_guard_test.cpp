@@ -362,9 +362,9 @@ StillWithOutliers still_with_bursts(std::uint64_t seed, bool same_way = false) {
 
 TEST(OutlierGuardInTheEngine, ABurstOfOutliersIsHeldWhole) {
   // Up to three outliers in a row are held (each far from the line and from the one before):
-  // with a lag their poses are the prediction's, flagged; at lag 0 they go out as measured and
-  // the poses after them are left alone. (Before bursts were held, the second of two was taken
-  // and bent the line.)
+  // with a lag their poses are the prediction's, flagged; at lag 0 the first goes out as
+  // measured and the rest at the prediction, flagged, and the poses after them are left alone.
+  // (Before bursts were held, the second of two was taken and bent the line.)
   const StillWithOutliers in = still_with_bursts(13);
   ASSERT_GE(in.outliers.size(), 40u);
   WindowConfig off;
@@ -390,16 +390,24 @@ TEST(OutlierGuardInTheEngine, ABurstOfOutliersIsHeldWhole) {
       }
     }
     if (lag == 0) {
-      EXPECT_EQ(flagged, 0u);
+      // Only the rest of a burst (its first sample goes out as measured).
+      for (std::size_t i = 1; i < guarded.size(); ++i) {
+        if (guarded[i].flags & kHeld) {
+          EXPECT_TRUE(std::find(in.outliers.begin(), in.outliers.end(), i - 1) != in.outliers.end()) << i;
+        }
+      }
+      EXPECT_GT(flagged, 0u);
+      EXPECT_LT(flagged, w.counters().held - w.counters().released);
     } else {
       // Counted per sample: a release may take back one channel and leave the other held.
       EXPECT_LE(flagged, w.counters().held);
       EXPECT_GE(flagged, w.counters().held - w.counters().released);
     }
-    // Rotation and position against the guard-free engine: at lag 0 0.79 and 0.88 (0.87 and
-    // 0.91 before), at lag 1 0.58 and 0.73 (0.83 and 0.82).
-    EXPECT_LT(rotation_rms(guarded), (lag == 0 ? 0.83 : 0.7) * rotation_rms(plain));
-    EXPECT_LT(position_rms(guarded), (lag == 0 ? 0.95 : 0.78) * position_rms(plain));
+    // Rotation and position against the guard-free engine: at lag 0 0.69 and 0.84 (0.87 and
+    // 0.91 before bursts were held, 0.79 and 0.88 with the rest of a burst emitted as measured),
+    // at lag 1 0.58 and 0.73 (0.83 and 0.82).
+    EXPECT_LT(rotation_rms(guarded), (lag == 0 ? 0.75 : 0.7) * rotation_rms(plain));
+    EXPECT_LT(position_rms(guarded), (lag == 0 ? 0.87 : 0.78) * position_rms(plain));
   }
 }
 
@@ -525,8 +533,9 @@ TEST(OutlierGuardInTheEngine, AHostileStreamKeepsEveryPromise) {
   // Outliers alone, in pairs and in threes, sudden turns, gaps, a change of rate, positions that
   // come and go, a tracker that freezes and jumps: at lags 0, 1 and 3, and with a horizon (at
   // lag 0), every sample is emitted once and in order, every pose is finite and (without a
-  // horizon, which has no ε) within ε of what was measured, and only a lag emits a held pose. (The holds and releases take the
-  // adaptation's copies and replays through every path the window has; under ASan too.)
+  // horizon, which has no ε) within ε of what was measured, and at lag 0 only the rest of a
+  // burst is emitted held. (The holds and releases take the adaptation's copies and replays
+  // through every path the window has; under ASan too.)
   std::mt19937_64 rng(12);
   std::normal_distribution<double> noise(0.0, 0.004);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -561,6 +570,7 @@ TEST(OutlierGuardInTheEngine, AHostileStreamKeepsEveryPromise) {
     }
     in.push_back(s);
   }
+  std::vector<std::size_t> flagged_at_lag_0, flagged_at_lag_1;
   for (const int lag : {0, 1, 3}) {
     for (const double horizon : {0.0, 0.02}) {
       if (lag > 0 && horizon > 0.0) continue;  // a prediction is emitted at once
@@ -586,12 +596,17 @@ TEST(OutlierGuardInTheEngine, AHostileStreamKeepsEveryPromise) {
         if (in[i].has_position()) {
           EXPECT_LE((p.position - p.measured_position).norm(), c.epsilon_t * (1.0 + 1e-9)) << i;
         }
-        if (lag == 0) {
-          EXPECT_EQ(p.flags & kHeld, 0u) << i;
-        }
+        if ((p.flags & kHeld) && horizon == 0.0 && lag <= 1) (lag == 0 ? flagged_at_lag_0 : flagged_at_lag_1).push_back(i);
       }
     }
   }
+  // At lag 0 only the rest of a burst goes out held: a sample held after a held one it did not
+  // release, which therefore stays held and goes out so with a lag (the guard decides alike at
+  // every lag; the sample itself may be released by the next, after lag 0 has emitted it).
+  EXPECT_GT(flagged_at_lag_0.size(), 0u);
+  EXPECT_LT(flagged_at_lag_0.size(), flagged_at_lag_1.size());
+  for (const std::size_t i : flagged_at_lag_0)
+    EXPECT_TRUE(std::binary_search(flagged_at_lag_1.begin(), flagged_at_lag_1.end(), i - 1)) << i;
 }
 
 }  // namespace

@@ -114,7 +114,7 @@ TEST(CausalCommand, SaysWhatTheOutlierGuardHeld) {
   const std::string run = "fair --causal '" + in_path.string() + "' -o '" + (dir / "o.csv").string() + "'";
   auto r = run_posefair(run, dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_THAT(r.out, HasSubstr("outliers 3 held at the prediction (threshold 8; at lag 0 each emitted as measured"));
+  EXPECT_THAT(r.out, HasSubstr("outliers 3 held at the prediction (threshold 8; at lag 0 each emitted as measured, but the rest of a burst"));
   r = run_posefair(run + " --lag 1", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("outliers 3 held at the prediction (threshold 8), 0 of them released"));

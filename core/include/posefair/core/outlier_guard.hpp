@@ -65,6 +65,9 @@ class OutlierGuard {
   // prediction, if the previous sample was held).
   Verdict check(double step, Vec3& increment);
   bool on() const { return threshold_ > 0.0; }
+  // The sample just held follows a held one: the second or third of a burst. Not a motion's
+  // start: a motion's next sample lands nearer the held one than the line, and releases it.
+  bool continues_burst() const { return held_run_ >= 2; }
   // A new window: the line starts afresh (the median, the stream's own, carries on).
   void restart() {
     count_ = 0;
