@@ -20,7 +20,8 @@
 // samples after it, and nothing new is held until it has left the line's points. So with a lag
 // the guard costs a sudden motion nothing. At lag 0 a held sample
 // is emitted before the next one comes, so the window emits it as measured and holds it only for
-// the poses after it (fairing_window.hpp): a sudden motion costs nothing there either.
+// the poses after it (fairing_window.hpp): a sudden motion costs nothing there either. The rest
+// of a burst (continues_burst) is no motion's start, and goes out at the prediction.
 // The median is the stream's own (its noise and how well its motion is predicted), so the
 // threshold needs no units; below a small floor nothing is held (a still, quantised stream whose
 // median is zero would otherwise hold every least bit it moves).
@@ -89,7 +90,7 @@ class OutlierGuard {
   bool ordinary_before_ = false;  // the sample before landed within kOrdinary times the median
   bool held_before_ = false;      // the sample before was held; held_offset_: its measurement from the prediction
   Vec3 held_offset_ = Vec3::Zero();
-  int held_run_ = 0;   // samples held in a row, up to the one before
+  int held_run_ = 0;   // samples held in a row, up to the newest checked
   int settling_ = 0;   // samples until a released step has left the line's points (nothing new is held)
 };
 
