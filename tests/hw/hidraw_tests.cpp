@@ -171,10 +171,9 @@ TEST(HidrawDaemon, TheGenuineStSensorDescriptorIsFoundByUsbIdDecodedAndPublished
   send_reports(device, drivers::encode_hid_orientation_report(st_layout(), q), 150);
   ASSERT_TRUE(wait_until([&] { return poses.count(1) >= 140 || !d.running(); }, 30s)) << poses.count(1) << "\n" << d.err();
   expect_all_near(poses, q, 1e-6);
-  d.send_signal(SIGUSR1);
-  ASSERT_TRUE(wait_for_log_or_exit(d, "; device connected, outages 0, reconnects 0", 10s)) << d.err();
-  const auto counters = last_counters(d.err(), "imu", 1);
+  const auto counters = counters_once_received(d, "imu", 1, 150, 10s);
   ASSERT_TRUE(counters) << d.err();
+  EXPECT_NE(counters->line.find("; device connected, outages 0, reconnects 0"), std::string::npos) << counters->line;
   EXPECT_EQ(counters->received, 150u) << counters->line;
   EXPECT_NE(counters->line.find(", frames 150, bad 0,"), std::string::npos) << counters->line;
   d.send_signal(SIGTERM);
@@ -205,10 +204,9 @@ TEST(HidrawDaemon, AVendorReportIsReadWithTheConfiguredLayout) {
   send_reports(device, drivers::encode_hid_vendor_report(layout, q), 100);
   ASSERT_TRUE(wait_until([&] { return poses.count(1) >= 90 || !d.running(); }, 30s)) << poses.count(1) << "\n" << d.err();
   expect_all_near(poses, q, 1e-6);
-  d.send_signal(SIGUSR1);
-  ASSERT_TRUE(wait_for_log_or_exit(d, "; device connected, outages 0, reconnects 0", 10s)) << d.err();
-  const auto counters = last_counters(d.err(), "imu", 1);
+  const auto counters = counters_once_received(d, "imu", 1, 100, 10s);
   ASSERT_TRUE(counters) << d.err();
+  EXPECT_NE(counters->line.find("; device connected, outages 0, reconnects 0"), std::string::npos) << counters->line;
   EXPECT_EQ(counters->received, 100u) << counters->line;
   EXPECT_NE(counters->line.find(", frames 100, bad 0,"), std::string::npos) << counters->line;
   d.send_signal(SIGTERM);
@@ -240,10 +238,9 @@ TEST(HidrawDaemon, ADeviceDestroyedAndCreatedAgainIsOneOutageAndSamplesResume) {
 
   ASSERT_TRUE(wait_until([&] { return poses.count(1) >= 100 || !d.running(); }, 30s)) << poses.count(1) << "\n" << d.err();
   expect_all_near(poses, q, 1e-6);
-  d.send_signal(SIGUSR1);
-  ASSERT_TRUE(wait_for_log_or_exit(d, "; device connected, outages 1, reconnects 1", 10s)) << d.err();
-  const auto counters = last_counters(d.err(), "imu", 1);
+  const auto counters = counters_once_received(d, "imu", 1, 120, 10s);
   ASSERT_TRUE(counters) << d.err();
+  EXPECT_NE(counters->line.find("; device connected, outages 1, reconnects 1"), std::string::npos) << counters->line;
   EXPECT_EQ(counters->received, 120u) << counters->line;
   EXPECT_NE(counters->line.find(", frames 120, bad 0,"), std::string::npos) << counters->line;
   EXPECT_EQ(count_of(d.err(), "lost the device"), 1u) << d.err();

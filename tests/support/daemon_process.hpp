@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -122,6 +123,26 @@ inline std::optional<Counters> last_counters(const std::string& log, const std::
     found = c;
   }
   return found;
+}
+
+// Asks the daemon for its counter lines (SIGUSR1) until the stream's line says it received at
+// least `at_least` samples: a test that waits for most of the poses to arrive, not all, may ask
+// while the last few are still on their way through the kernel (a reader scheduled late). The
+// last line read in any case; nothing if the daemon wrote none before the timeout.
+inline std::optional<Counters> counters_once_received(Subprocess& p, const std::string& name, std::uint32_t id,
+                                                      std::uint64_t at_least, std::chrono::milliseconds timeout) {
+  const std::string head = "stream " + name + " (id " + std::to_string(id) + ", ";
+  const auto deadline = Clock::now() + timeout;
+  std::optional<Counters> c;
+  do {
+    const std::size_t lines = count_of(p.err(), head);
+    p.send_signal(SIGUSR1);
+    if (!wait_for_log_or_exit(p, head, 2s, lines + 1)) break;
+    c = last_counters(p.err(), name, id);
+    if (c && c->received >= at_least) break;
+    std::this_thread::sleep_for(100ms);
+  } while (Clock::now() < deadline);
+  return c;
 }
 
 inline std::vector<std::string> daemon_args(const fs::path& config) {
