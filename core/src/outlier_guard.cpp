@@ -62,7 +62,11 @@ OutlierGuard::Verdict OutlierGuard::check(double step, Vec3& increment) {
                             ((ordinary_before_ && settled) || (held_before && held_run < kMaxHeldRun));
       ordinary_before_ = warm && distance <= kOrdinary * median;
       const double log_distance = std::log(std::max(distance, 1e-300));
-      if (warm) {
+      if (increment.isZero(0.0)) {
+        // The same measurement again (a tracker that repeats its last value while it sees
+        // nothing): not a new one, and the line soon predicts it exactly, so learning from it would
+        // bring the median down towards nothing and, once the stream moves again, hold its noise.
+      } else if (warm) {
         log_median_ += kRate * (log_distance > log_median_ ? 1.0 : -1.0);
       } else {
         // Counted only up to the warm-up: a daemon's stream outlives an int's count of samples.

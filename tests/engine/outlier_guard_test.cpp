@@ -179,6 +179,23 @@ TEST(OutlierGuard, HoldsNothingWhileWarmingUpOrOff) {
   EXPECT_EQ(count(v, Verdict::Take), v.size());
 }
 
+TEST(OutlierGuard, AFrozenStretchLeavesTheMedianAsItWas) {
+  // A tracker that repeats its last value for two seconds (it sees nothing), then goes on from
+  // where the motion is by then. The repeats are no new measurements: learnt from, they brought
+  // the median down towards nothing, and once the stream moved again its noise was held (and
+  // released) for a hundred samples or so. Now only the jump back onto the motion is held, and
+  // released by the sample after it.
+  const std::vector<Vec3> line = noisy_line(800, 0.001, 11);
+  std::vector<Vec3> x = line;
+  for (std::size_t i = 300; i < 500; ++i) x[i] = x[299];
+  OutlierGuard guard(kDefaultOutlierThreshold, 1.0);
+  const auto v = feed(guard, x, 0.01);
+  EXPECT_EQ(v[499], Verdict::Hold);  // x[500]: the jump
+  EXPECT_EQ(v[500], Verdict::Release);
+  EXPECT_EQ(count(v, Verdict::Hold), 1u);
+  EXPECT_EQ(count(v, Verdict::Release), 1u);
+}
+
 TEST(OutlierGuard, AQuantisedStillStreamHoldsNothing) {
   // Still, and quantised: its prediction error is zero nearly always, so the percentile is zero;
   // a least bit it moves now and then is under the floor, not an outlier.
