@@ -26,9 +26,8 @@ OutlierGuard::OutlierGuard(double threshold, double scale) : threshold_(threshol
 OutlierGuard::Verdict OutlierGuard::check(double step, Vec3& increment) {
   if (threshold_ <= 0.0) return Verdict::Take;
   Verdict verdict = Verdict::Take;
-  const bool held_before = held_before_;
   const int held_run = held_run_;
-  held_before_ = false;
+  const bool held_before = held_run > 0;
   held_run_ = 0;
   // A released sample is a step the line runs through for the next kOutlierFitPoints − 1
   // samples; its prediction overshoots the stream meanwhile, so a sample far from it is no sign of
@@ -82,7 +81,6 @@ OutlierGuard::Verdict OutlierGuard::check(double step, Vec3& increment) {
         settling_ = kOutlierFitPoints - 1;
       } else if (held_now) {
         held_offset_ = increment - predicted;
-        held_before_ = true;
         held_run_ = held_run + 1;
         increment = predicted;
         verdict = Verdict::Hold;

@@ -72,7 +72,7 @@ class OutlierGuard {
   // A new window: the line starts afresh (the median, the stream's own, carries on).
   void restart() {
     count_ = 0;
-    ordinary_before_ = held_before_ = false;
+    ordinary_before_ = false;
     held_run_ = 0;
     settling_ = 0;
   }
@@ -88,9 +88,8 @@ class OutlierGuard {
   double log_median_ = 0.0;
   int seen_ = 0;  // distances seen, up to kOutlierWarmUp
   bool ordinary_before_ = false;  // the sample before landed within kOrdinary times the median
-  bool held_before_ = false;      // the sample before was held; held_offset_: its measurement from the prediction
-  Vec3 held_offset_ = Vec3::Zero();
-  int held_run_ = 0;   // samples held in a row, up to the newest checked
+  Vec3 held_offset_ = Vec3::Zero();  // the newest held sample's measurement from the prediction
+  int held_run_ = 0;   // samples held in a row, up to the newest checked (0: the sample before was not held)
   int settling_ = 0;   // samples until a released step has left the line's points (nothing new is held)
 };
 
