@@ -1,5 +1,5 @@
 #pragma once
-// Runs the real `posefair` binary as a user would, capturing its exit status and output.
+// Runs the real `posefair` binary (or a tool script) as a user would, capturing its exit status and output.
 #include <sys/wait.h>
 
 #include <cstdlib>
@@ -24,10 +24,10 @@ inline std::string q(const std::filesystem::path& p) {
   return quoted;
 }
 
-inline CliResult run_posefair(const std::string& args, const ScratchDir& dir) {
-  const std::string bin = POSEFAIR_CLI_PROGRAM;
+// Runs `program args` (args as on a shell command line), its stdout and stderr kept in dir.
+inline CliResult run_program(const std::string& program, const std::string& args, const ScratchDir& dir) {
   const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd = "'" + bin + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
+  const std::string cmd = "'" + program + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
   const int status = std::system(cmd.c_str());
   CliResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -35,5 +35,7 @@ inline CliResult run_posefair(const std::string& args, const ScratchDir& dir) {
   r.err = slurp(err);
   return r;
 }
+
+inline CliResult run_posefair(const std::string& args, const ScratchDir& dir) { return run_program(POSEFAIR_CLI_PROGRAM, args, dir); }
 
 }  // namespace posefair::testing
