@@ -166,6 +166,27 @@ TEST(OutlierGuard, TheLastOfABurstIsReleasedWhenTheSamplesAfterItFollowIt) {
   EXPECT_EQ(count(v, Verdict::Release), 1u);
 }
 
+TEST(OutlierGuard, AFastMotionSlowingDownIsReleasedByItsNextSample) {
+  // A quick turn at 60 Hz, 0.167 rad a sample, that starts to slow down: its first slower sample
+  // falls behind the line and is held; the next goes on from it at about the line's pace, but
+  // lands nearer the line than the held measurement (the step itself is 0.1 rad), and was held
+  // as a burst's second sample, emitted at the line's prediction at lag 0, 0.09 rad off. It goes on
+  // from the held measurement as the line goes on from the prediction: a motion, released.
+  std::vector<Vec3> x = noisy_line(400, 0.001, 13);
+  const Vec3 direction = Vec3(0.6, -0.64, 0.48);  // unit
+  Vec3 along = Vec3::Zero();
+  for (std::size_t i = 1; i < x.size(); ++i) {
+    const double slowing = i < 300 ? 0.0 : 0.03 * static_cast<double>(i - 299);
+    along += std::max(0.0, 0.167 - slowing) * direction;
+    x[i] += along;
+  }
+  OutlierGuard guard(kDefaultOutlierThreshold, 1.0);
+  const auto v = feed(guard, x, 1.0 / 60.0);
+  EXPECT_EQ(count(v, Verdict::Hold) - count(v, Verdict::Release), 0u) << "nothing stays held";
+  ASSERT_EQ(v[299], Verdict::Hold);     // x[300]: 0.03 rad behind the line
+  EXPECT_EQ(v[300], Verdict::Release);  // x[301]: 0.09 behind it, 0.107 from the held one (held before)
+}
+
 TEST(OutlierGuard, HoldsNothingWhileWarmingUpOrOff) {
   std::vector<Vec3> x = noisy_line(400, 0.001, 5);
   x[10] += Vec3(0.05, 0.0, 0.0);   // before the median is trusted
@@ -547,7 +568,7 @@ TEST(OutlierGuardInTheEngine, AQuickTurnsStartIsReleasedAndFollowedAsWithoutTheG
 }
 
 TEST(OutlierGuardInTheEngine, AHostileStreamKeepsEveryPromise) {
-  // Outliers alone, in pairs and in threes, sudden turns, gaps, a change of rate, positions that
+  // Outliers alone, in pairs and in threes (each thrown its own way, or all by one offset), sudden turns, gaps, a change of rate, positions that
   // come and go, a tracker that freezes and jumps: at lags 0, 1 and 3, and with a horizon (at
   // lag 0), every sample is emitted once and in order, every pose is finite and (without a
   // horizon, which has no ε) within ε of what was measured, and at lag 0 only the rest of a
@@ -559,6 +580,7 @@ TEST(OutlierGuardInTheEngine, AHostileStreamKeepsEveryPromise) {
   std::vector<Sample> in;
   double t = 0.0, yaw = 0.0, rate = 100.0;
   int burst = 0;
+  bool scattered = false;  // each sample of the burst thrown its own way, or all by one offset
   Vec3 burst_off = Vec3::Zero(), frozen_r = Vec3::Zero();
   for (int i = 0; i < 3000; ++i) {
     if (i == 1500) rate = 50.0;
@@ -566,7 +588,10 @@ TEST(OutlierGuardInTheEngine, AHostileStreamKeepsEveryPromise) {
     if (u(rng) < 0.01) yaw += 0.5;              // a sudden turn that stays
     if (burst == 0 && u(rng) < 0.03) {
       burst = 1 + static_cast<int>(u(rng) * 3.0);
+      scattered = u(rng) < 0.5;
       burst_off = Vec3(0.2 * u(rng), -0.15, 0.1 * u(rng));
+    } else if (burst > 0 && scattered) {
+      burst_off = Vec3(0.2 * u(rng), 0.3 * u(rng) - 0.15, -0.1 * u(rng));
     }
     const bool frozen = (i / 100) % 7 == 3;  // the tracker repeats its last value
     Vec3 r = Vec3(0.02 * std::sin(t), 0.01 * std::cos(2.0 * t), yaw + 0.1 * std::sin(0.5 * t)) +

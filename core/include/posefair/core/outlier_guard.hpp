@@ -13,9 +13,9 @@
 // mostly builds up over a sample or two, which puts the sample before it off the line already;
 // and the sample after a held one tells an outlier from a motion's start or a jump that stays:
 // after an outlier it lands near the line (or, in a burst of outliers, far from both the line and
-// the held one, and is held too, up to kMaxHeldRun in a row), after a start nearer the held
-// measurement than the line, and the held sample is released (taken back into the window as
-// measured, and emitted so if the window's lag has not emitted it yet; the window's adaptation
+// the line's step from the held one, and is held too, up to kMaxHeldRun in a row), after a start
+// nearer the line's step from the held measurement than the line, and the held sample is
+// released (taken back into the window as measured, and emitted so if the window's lag has not emitted it yet; the window's adaptation
 // learns from it as if it had never been held). A released sample is a step in the line for the
 // samples after it, and nothing new is held until it has left the line's points. So with a lag
 // the guard costs a sudden motion nothing. At lag 0 a held sample
@@ -59,15 +59,15 @@ class OutlierGuard {
     Take,
     Hold,     // an outlier (alone, or in a burst): increment is replaced by the prediction
     Release,  // the sample before was held, but this one says a motion started: it lands nearer
-              // the held measurement than the line. Take the held sample back as measured;
-              // increment is made relative to it.
+              // the line's step from the held measurement than the line. Take the held sample
+              // back as measured; increment is made relative to it.
   };
   // The sample `step` seconds after the previous one, `increment` from it (from the held
   // prediction, if the previous sample was held).
   Verdict check(double step, Vec3& increment);
   bool on() const { return threshold_ > 0.0; }
   // The sample just held follows a held one: the second or third of a burst. Not a motion's
-  // start: a motion's next sample lands nearer the held one than the line, and releases it.
+  // start: a motion's next sample goes on from the held one as the line goes on, and releases it.
   bool continues_burst() const { return held_run_ >= 2; }
   // A new window: the line starts afresh (the median, the stream's own, carries on).
   void restart() {
