@@ -1,6 +1,8 @@
-# `posefair bench quality`, `posefair bench latency`, `posefair bench fusion` and `posefair bench gyro-fairing` (docs/benchmarks.md).
+# `posefair bench quality`, `posefair bench streams`, `posefair bench latency`, `posefair bench fusion` and `posefair bench gyro-fairing` (docs/benchmarks.md).
 target_sources(posefair_cli PRIVATE
   ${CMAKE_CURRENT_SOURCE_DIR}/bench_quality_command.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/bench_streams_command.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/generated_streams.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/bench_latency_command.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/bench_fusion_command.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/bench_gyro_fairing_command.cpp

@@ -4,6 +4,7 @@
 #include "bench_fusion_command.hpp"
 #include "bench_gyro_fairing_command.hpp"
 #include "bench_latency_command.hpp"
+#include "bench_streams_command.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -556,6 +557,7 @@ void add_bench_command(CLI::App& app, int& exit_code) {
   quality->add_flag("--quick", *quick, "synthetic data only, one noise level, shorter, fewer seeds (seconds, for tests)");
   quality->add_option("--set", *only, "run only this data set or kind (broad, tum, bvh, synthetic); repeat it for several (default: all)");
   quality->callback([=, &exit_code] { exit_code = bench_quality(*data, *out, *quick, *only); });
+  add_bench_streams_command(*bench, exit_code);
   add_bench_latency_command(*bench, exit_code);
   add_bench_fusion_command(*bench, exit_code);
   add_bench_gyro_fairing_command(*bench, exit_code);

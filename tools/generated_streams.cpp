@@ -1,0 +1,168 @@
+#include "generated_streams.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+
+#include "posefair/core/so3.hpp"
+#include "posefair/core/synthetic_motion.hpp"
+
+namespace posefair::tools {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+constexpr double kWarmUpSeconds = 1.0;
+
+// FNV-1a of the name: the same seed on every platform (std::hash is not).
+std::uint64_t seed_of(const std::string& name) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : name) h = (h ^ c) * 1099511628211ULL;
+  return h;
+}
+
+Vec3 random_axis(std::mt19937_64& rng) {
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  Vec3 a(gauss(rng), gauss(rng), gauss(rng));
+  return a.normalized();
+}
+
+// Three slow sines about the three axes.
+std::function<Quat(double)> sway(std::mt19937_64& rng, double amplitude) {
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::array<double, 3> f{}, phase{};
+  for (int k = 0; k < 3; ++k) {
+    f[static_cast<std::size_t>(k)] = 0.2 + 0.6 * uni(rng);
+    phase[static_cast<std::size_t>(k)] = kTwoPi * uni(rng);
+  }
+  return [=](double t) {
+    Vec3 v;
+    for (int k = 0; k < 3; ++k) v(k) = amplitude * std::sin(kTwoPi * f[static_cast<std::size_t>(k)] * t + phase[static_cast<std::size_t>(k)]);
+    return so3::from_rotation_vector(v);
+  };
+}
+
+// Rests and quick turns (smoothstep in the angle).
+std::function<Quat(double)> turns(std::mt19937_64& rng, double seconds) {
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  struct Turn {
+    double start, duration;
+    Vec3 rotation;
+    Quat before;
+  };
+  std::vector<Turn> list;
+  Quat q = Quat::Identity();
+  for (double t = 0.5 + 1.5 * uni(rng); t < seconds;) {
+    const double angle = (30.0 + 90.0 * uni(rng)) * std::numbers::pi / 180.0;
+    const Turn turn{t, 0.15 + 0.25 * uni(rng), random_axis(rng) * angle, q};
+    list.push_back(turn);
+    q = (turn.before * so3::from_rotation_vector(turn.rotation)).normalized();
+    t += turn.duration + 0.5 + 1.5 * uni(rng);
+  }
+  return [list](double t) {
+    Quat at = Quat::Identity();
+    for (const Turn& turn : list) {
+      if (t < turn.start) break;
+      const double u = std::min(1.0, (t - turn.start) / turn.duration);
+      at = (turn.before * so3::from_rotation_vector(u * u * (3.0 - 2.0 * u) * turn.rotation)).normalized();
+    }
+    return at;
+  };
+}
+
+// A handheld camera: body rate ω an Ornstein–Uhlenbeck process, integrated on a fine grid
+// (dt) and looked up between its points.
+std::function<Quat(double)> walk(std::mt19937_64& rng, double seconds, double dt) {
+  constexpr double kRms = 0.5, kCorrelation = 0.3;
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const double a = std::exp(-dt / kCorrelation), b = kRms * std::sqrt(1.0 - a * a);
+  const auto n = static_cast<std::size_t>(std::ceil(seconds / dt)) + 2;
+  std::vector<double> time(n);
+  std::vector<Quat> q(n);
+  Vec3 w(gauss(rng), gauss(rng), gauss(rng));
+  w *= kRms;
+  Quat at = Quat::Identity();
+  for (std::size_t i = 0; i < n; ++i) {
+    time[i] = static_cast<double>(i) * dt;
+    q[i] = at;
+    at = (at * so3::from_rotation_vector(w * dt)).normalized();
+    w = a * w + b * Vec3(gauss(rng), gauss(rng), gauss(rng));
+  }
+  auto track = std::make_shared<TruthTrack>(std::move(time), std::move(q), 1.5 * dt);
+  return [track](double t) {
+    std::size_t cursor = 0;
+    Quat out = Quat::Identity();
+    track->at(t, out, cursor);
+    return out;
+  };
+}
+
+}  // namespace
+
+std::string GeneratedStreamSpec::name() const {
+  char b[96];
+  std::snprintf(b, sizeof b, "%s-%gHz-noise%g", motion.c_str(), rate_hz, noise);
+  return b;
+}
+
+std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick) {
+  std::vector<GeneratedStreamSpec> out;
+  if (quick) {
+    for (const char* motion : {"sway", "turns"})
+      for (double rate : {30.0, 100.0}) out.push_back({motion, rate, 0.01, 5.0});
+    return out;
+  }
+  for (const char* motion : {"still", "sway", "turns", "shake", "walk"})
+    for (double rate : {10.0, 30.0, 60.0, 120.0, 250.0, 1000.0})
+      for (double noise : {0.002, 0.01, 0.04}) out.push_back({motion, rate, noise, rate > 500.0 ? 10.0 : 20.0});
+  return out;
+}
+
+QualitySequence generated_stream(const GeneratedStreamSpec& spec) {
+  std::mt19937_64 rng(seed_of(spec.name()));
+  const double dense_rate = std::max(8.0 * spec.rate_hz, 2000.0);
+  std::function<Quat(double)> truth_at;
+  if (spec.motion == "still") {
+    truth_at = [](double) { return Quat::Identity(); };
+  } else if (spec.motion == "sway") {
+    truth_at = sway(rng, 0.4);
+  } else if (spec.motion == "turns") {
+    truth_at = turns(rng, spec.seconds);
+  } else if (spec.motion == "shake") {
+    const auto slow = sway(rng, 0.4);
+    std::uniform_real_distribution<double> uni(0.0, 1.0);
+    const double f = 5.0 + 4.0 * uni(rng);
+    const Vec3 axis = random_axis(rng);
+    truth_at = [slow, f, axis](double t) { return (slow(t) * so3::from_rotation_vector(0.02 * std::sin(kTwoPi * f * t) * axis)).normalized(); };
+  } else if (spec.motion == "walk") {
+    truth_at = walk(rng, spec.seconds, 1.0 / dense_rate);
+  } else {
+    throw std::invalid_argument("no generated motion '" + spec.motion + "' (still, sway, turns, shake, walk)");
+  }
+  QualitySequence s;
+  s.name = spec.name();
+  s.rate_hz = spec.rate_hz;
+  const auto n = static_cast<std::size_t>(spec.seconds * spec.rate_hz);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / spec.rate_hz;
+    s.input.time.push_back(t);
+    s.input.orientation.push_back((truth_at(t) * so3::exp(random_offset(rng, spec.noise))).normalized());
+  }
+  std::vector<double> time;
+  std::vector<Quat> orientation;
+  const double last = s.input.time.back();
+  for (std::size_t i = 0; static_cast<double>(i) / dense_rate <= last + 1e-12; ++i) {
+    time.push_back(static_cast<double>(i) / dense_rate);
+    orientation.push_back(truth_at(time.back()));
+  }
+  s.truth = TruthTrack(std::move(time), std::move(orientation), 1.5 / dense_rate);
+  s.use.assign(n, 1);
+  for (std::size_t i = 0; i < n && static_cast<double>(i) < kWarmUpSeconds * spec.rate_hz; ++i) s.use[i] = 0;
+  return s;
+}
+
+}  // namespace posefair::tools

@@ -1,0 +1,37 @@
+#pragma once
+// The streams of `posefair bench streams` (docs/benchmarks.md, "Generated streams"): motions
+// that no default or grid was chosen on, each sampled at rates from 10 Hz to 1 kHz with three
+// noise levels, so that the defaults can be judged on streams unlike the benchmark's data sets.
+//   still   a tracker lying still
+//   sway    slow wandering, three sines of 0.2–0.8 Hz about the three axes (0.4 rad each)
+//   turns   a head in VR: still for 0.5–2 s, then turned 30–120° in 0.15–0.4 s, and so on
+//   shake   sway plus a tremor of 0.02 rad at 5–9 Hz (above Nyquist at 10 Hz: aliased)
+//   walk    a handheld camera: angular velocity an Ornstein–Uhlenbeck process (0.5 rad/s RMS,
+//           correlation time 0.3 s), integrated
+// Noise as the quality benchmark's synthetic sets: exp(δ), ‖δ‖ uniform below the bound (dist on
+// S³). Deterministic: the seed is the stream's name. The truth is sampled 8 times as densely
+// (at least 2 kHz), so it can be looked up between samples.
+#include <string>
+#include <vector>
+
+#include "quality_datasets.hpp"
+
+namespace posefair::tools {
+
+struct GeneratedStreamSpec {
+  std::string motion;  // still, sway, turns, shake, walk
+  double rate_hz = 100.0;
+  double noise = 0.01;  // bound on ‖δ‖ (rad)
+  double seconds = 20.0;
+  std::string name() const;  // "sway-100Hz-noise0.01"
+};
+
+// Every motion × rate (10, 30, 60, 120, 250, 1000 Hz) × noise (0.002, 0.01, 0.04); quick: sway
+// and turns at 30 and 100 Hz, noise 0.01, 5 s.
+std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick);
+
+// The stream, its truth, and its first second (warm-up) left out of scoring. Throws
+// std::invalid_argument for a motion it does not know.
+QualitySequence generated_stream(const GeneratedStreamSpec& spec);
+
+}  // namespace posefair::tools
