@@ -5,10 +5,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <stdexcept>
 
+#include "posefair/core/rests_and_turns.hpp"
 #include "posefair/core/so3.hpp"
 #include "posefair/core/synthetic_motion.hpp"
 
@@ -48,30 +50,16 @@ std::function<Quat(double)> sway(std::mt19937_64& rng, double amplitude) {
 
 // Rests and quick turns (smoothstep in the angle).
 std::function<Quat(double)> turns(std::mt19937_64& rng, double seconds) {
-  std::uniform_real_distribution<double> uni(0.0, 1.0);
-  struct Turn {
-    double start, duration;
-    Vec3 rotation;
-    Quat before;
-  };
-  std::vector<Turn> list;
-  Quat q = Quat::Identity();
-  for (double t = 0.5 + 1.5 * uni(rng); t < seconds;) {
-    const double angle = (30.0 + 90.0 * uni(rng)) * std::numbers::pi / 180.0;
-    const Turn turn{t, 0.15 + 0.25 * uni(rng), random_axis(rng) * angle, q};
-    list.push_back(turn);
-    q = (turn.before * so3::from_rotation_vector(turn.rotation)).normalized();
-    t += turn.duration + 0.5 + 1.5 * uni(rng);
-  }
-  return [list](double t) {
-    Quat at = Quat::Identity();
-    for (const Turn& turn : list) {
-      if (t < turn.start) break;
-      const double u = std::min(1.0, (t - turn.start) / turn.duration);
-      at = (turn.before * so3::from_rotation_vector(u * u * (3.0 - 2.0 * u) * turn.rotation)).normalized();
-    }
-    return at;
-  };
+  RestsAndTurnsSpec spec;
+  spec.seconds = seconds;
+  spec.rest_min_s = 0.5;
+  spec.rest_max_s = 2.0;
+  spec.angle_min_deg = 30.0;
+  spec.angle_max_deg = 120.0;
+  spec.turn_min_s = 0.15;
+  spec.turn_max_s = 0.4;
+  auto motion = std::make_shared<RestsAndTurns>(spec, rng);
+  return [motion](double t) { return motion->at(t); };
 }
 
 // A handheld camera: body rate ω an Ornstein–Uhlenbeck process, integrated on a fine grid

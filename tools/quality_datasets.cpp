@@ -18,6 +18,7 @@
 #include "benchmark_data.hpp"
 #include "posefair/core/quality_metrics.hpp"
 #include "posefair/core/stream_rate.hpp"
+#include "posefair/core/rests_and_turns.hpp"
 #include "posefair/core/synthetic_motion.hpp"
 #include "posefair/formats/pose_file.hpp"
 
@@ -59,32 +60,10 @@ QualitySequence rests_and_turns(double rate, double noise, std::uint64_t seed) {
   constexpr int kDense = 8;
   constexpr double kSeconds = 20.0;
   std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> uni(0.0, 1.0);
-  std::normal_distribution<double> gauss(0.0, 1.0);
-  struct Turn {
-    double start, duration;
-    Vec3 rotation;  // axis × angle (rad)
-    Quat before;
-  };
-  std::vector<Turn> turns;
-  Quat q = Quat::Identity();
-  for (double t = 1.0 + 2.0 * uni(rng); t < kSeconds;) {
-    Vec3 axis(gauss(rng), gauss(rng), gauss(rng));
-    const double angle = (20.0 + 70.0 * uni(rng)) * std::numbers::pi / 180.0;
-    const Turn turn{t, 0.3 + 0.5 * uni(rng), axis.normalized() * angle, q};
-    turns.push_back(turn);
-    q = (turn.before * so3::from_rotation_vector(turn.rotation)).normalized();
-    t += turn.duration + 1.0 + 2.0 * uni(rng);
-  }
-  const auto truth_at = [&](double t) {
-    Quat at = Quat::Identity();
-    for (const Turn& turn : turns) {
-      if (t < turn.start) break;
-      const double u = std::min(1.0, (t - turn.start) / turn.duration);
-      at = (turn.before * so3::from_rotation_vector(u * u * (3.0 - 2.0 * u) * turn.rotation)).normalized();
-    }
-    return at;
-  };
+  RestsAndTurnsSpec spec;  // still 1–3 s, turned 20–90° in 0.3–0.8 s
+  spec.seconds = kSeconds;
+  const RestsAndTurns motion(spec, rng);
+  const auto truth_at = [&](double t) { return motion.at(t); };
   QualitySequence s;
   s.name = "seed" + std::to_string(seed);
   s.rate_hz = rate;
