@@ -1,6 +1,7 @@
 #include "generated_streams.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
