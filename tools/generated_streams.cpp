@@ -51,14 +51,13 @@ std::function<Quat(double)> sway(std::mt19937_64& rng, double amplitude) {
 
 // Rests and quick turns (smoothstep in the angle).
 std::function<Quat(double)> turns(std::mt19937_64& rng, double seconds) {
-  RestsAndTurnsSpec spec;
-  spec.seconds = seconds;
-  spec.rest_min_s = 0.5;
-  spec.rest_max_s = 2.0;
-  spec.angle_min_deg = 30.0;
-  spec.angle_max_deg = 120.0;
-  spec.turn_min_s = 0.15;
-  spec.turn_max_s = 0.4;
+  const RestsAndTurnsSpec spec{.seconds = seconds,
+                               .rest_min_s = 0.5,
+                               .rest_max_s = 2.0,
+                               .angle_min_deg = 30.0,
+                               .angle_max_deg = 120.0,
+                               .turn_min_s = 0.15,
+                               .turn_max_s = 0.4};
   auto motion = std::make_shared<RestsAndTurns>(spec, rng);
   return [motion](double t) { return motion->at(t); };
 }
