@@ -15,8 +15,8 @@
 // after an outlier it lands near the line (or, in a burst of outliers, far from both the line and
 // the line's step from the held one, and is held too, up to kMaxHeldRun in a row), after a start
 // nearer the line's step from the held measurement than the line, and the held sample is
-// released (taken back into the window as measured, and emitted so if the window's lag has not emitted it yet; the window's adaptation
-// learns from it as if it had never been held). A released sample is a step in the line for the
+// released (taken back into the window as measured, and emitted so if the window's lag has not
+// emitted it yet; the window's adaptation learns from it as if it had never been held). A released sample is a step in the line for the
 // samples after it, and nothing new is held until it has left the line's points. So with a lag
 // the guard costs a sudden motion nothing. At lag 0 a held sample
 // is emitted before the next one comes, so the window emits it as measured and holds it only for
