@@ -2,7 +2,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +15,7 @@
 
 #include "generated_streams.hpp"
 #include "posefair/core/error.hpp"
+#include "posefair/core/upper_median.hpp"
 #include "quality_configurations.hpp"
 #include "quality_scoring.hpp"
 
@@ -80,11 +80,7 @@ std::string pct(double x, double ref) {
   return b;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+double median(std::vector<double> v) { return v.empty() ? 0.0 : upper_median(v); }
 
 int bench_streams(const std::string& out_dir, bool quick) {
   const auto t0 = std::chrono::steady_clock::now();
