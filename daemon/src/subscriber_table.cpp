@@ -89,10 +89,15 @@ std::size_t SubscriberTable::size() const {
   return static_cast<std::size_t>(std::count(used_.begin(), used_.end(), 1));
 }
 
+// Filled under the lock, waiting for it: this runs before the publisher's first pose, so a
+// subscriber already in the table is sent that pose even when the control thread holds the
+// lock then (a view that refresh() had to fill would miss poses until the lock was free).
 SubscriberTable::View SubscriberTable::make_view() const {
   View v;
   v.entries.resize(slots_.size());
   v.slot.resize(slots_.size());
+  const std::lock_guard lock(mutex_);
+  copy_locked(v);
   return v;
 }
 
@@ -101,6 +106,10 @@ void SubscriberTable::refresh(View& v) const {
   if (g == v.generation) return;
   std::unique_lock lock(mutex_, std::try_to_lock);
   if (!lock.owns_lock()) return;  // the control thread is changing it: next pose
+  copy_locked(v);
+}
+
+void SubscriberTable::copy_locked(View& v) const {
   v.count = 0;
   for (std::size_t i = 0; i < slots_.size(); ++i) {
     if (!used_[i]) continue;

@@ -70,12 +70,15 @@ class SubscriberTable {
     std::size_t count = 0;
     std::uint64_t generation = ~std::uint64_t{0};
   };
+  // The publisher's view, allocated and filled now (not on the real-time thread: it waits for the lock).
   View make_view() const;
   // Brings v up to date when the table changed and its lock is free; otherwise leaves it.
   void refresh(View& v) const;
   void count_sent(std::uint32_t slot, std::uint64_t n) { sent_[slot].fetch_add(n, std::memory_order_relaxed); }
 
  private:
+  void copy_locked(View& v) const;  // with mutex_ held
+
   std::vector<Subscriber> slots_;
   std::vector<char> used_;
   std::unique_ptr<std::atomic<std::uint64_t>[]> sent_;
