@@ -64,11 +64,32 @@ Vec3 median_of_three(const Vec3& a, const Vec3& b, const Vec3& c) {
   return a.cwiseMin(b).cwiseMax(a.cwiseMax(b).cwiseMin(c));
 }
 
+// D^kθ at the newest sample, as D^{k−1} of the newest k differences ζ: its weights on them
+// (±C(k−1, j)), and σ per unit of the median of its length under white noise of σ per component
+// (a χ with 3 degrees of freedom, scaled by D^k's noise gain C(2k, k)).
+static_assert(3 + 2 + MotionNoiseEstimator::kNoiseOrderAbove <= std::tuple_size_v<decltype(NoiseDifference::weights)>,
+              "the highest order the noise estimate reads, at m = 3");
+NoiseDifference noise_difference(int k) {
+  NoiseDifference d;
+  d.order = k;
+  for (int j = 0; j < k; ++j) d.weights[static_cast<std::size_t>(j)] = ((k - 1 - j) % 2 == 0 ? 1.0 : -1.0) * binomial(k - 1, j);
+  d.sigma_per_median = 1.0 / (kChi3Median * std::sqrt(binomial(2 * k, k)));
+  return d;
+}
+
+Vec3 newest_difference(std::span<const Vec3> zeta, const NoiseDifference& d) {
+  const std::size_t base = zeta.size() - static_cast<std::size_t>(d.order);
+  Vec3 v = Vec3::Zero();
+  for (int j = 0; j < d.order; ++j) v += d.weights[static_cast<std::size_t>(j)] * zeta[base + static_cast<std::size_t>(j)];
+  return v;
+}
+
 }  // namespace
 
 MotionNoiseEstimator::MotionNoiseEstimator(int capacity, int order)
     : order_(order),
       capacity_(capacity),
+      low_(noise_difference(order + 2)),
       fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
       short_fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
       window_fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
@@ -102,26 +123,27 @@ void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& s
   // +2.6% and +3.2% error with it), as a longer fit span did (docs/engine.md).
   const bool window_fit = line_span_ >= m + 1 && line_span_ <= 2.0 * settings.motion_span_s * rate_hz + 1.0;
   window_fit_noise_gain_ = window_fit ? derivative_fit_weights(line_span_, m, window_fit_) : 0.0;
+  // The noise estimate's higher order, as high as the window's differences allow (7 at 10 Hz,
+  // where the window holds 8 samples), and none if that is not above m + 2.
+  const int high = std::min(m + 2 + kNoiseOrderAbove, line_span_ - 1);
+  const int high_order = high > m + 2 ? high : 0;
+  if (high_order != high_.order) e_.high = {};  // its median was of another order
+  high_ = high_order > 0 ? noise_difference(high_order) : NoiseDifference{};
 }
 
-void MotionNoiseEstimator::update_noise(double length, double dt) {
-  const int k = order_ + 2;
-  const double scale = kChi3Median * std::sqrt(binomial(2 * k, k));  // ‖D^kθ‖ median per unit σ
-  const double floor = 1e-300;
-  length = std::max(length, floor);
-  if (e_.noise_count < static_cast<int>(e_.first_lengths.size())) {
+void MotionNoiseEstimator::update_median(Estimates::LengthMedian& m, double length, double dt) const {
+  length = std::max(length, 1e-300);
+  if (!m.settled()) {
     // Exact median of the first values: a sound start for the tracker below.
-    e_.first_lengths[static_cast<std::size_t>(e_.noise_count++)] = length;
-    std::array<double, 15> sorted = e_.first_lengths;
-    e_.log_median = std::log(upper_median(std::span(sorted).first(static_cast<std::size_t>(e_.noise_count))));
+    m.first_lengths[static_cast<std::size_t>(m.count++)] = length;
+    std::array<double, 15> sorted = m.first_lengths;
+    m.log_median = std::log(upper_median(std::span(sorted).first(static_cast<std::size_t>(m.count))));
   } else {
     // Stochastic approximation of the median in log space: a step up when above, down when
     // below; its time constant is about 1/(2·step) samples.
     const double step = std::min(0.5, 0.5 * dt / settings_.noise_time_s);
-    e_.log_median += std::log(length) > e_.log_median ? step : -step;
+    m.log_median += std::log(length) > m.log_median ? step : -step;
   }
-  const double sigma = std::exp(e_.log_median) / scale;
-  e_.noise_var = sigma * sigma;
 }
 
 double MotionNoiseEstimator::newest_half_fit_of_medians(std::span<const Vec3> zeta) const {
@@ -163,20 +185,20 @@ double MotionNoiseEstimator::motion_floor(double fit_noise) const {
 
 bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
   const int n1 = static_cast<int>(zeta.size());  // differences available
-  const int k = order_ + 2;
   if (!(dt > 0.0)) return false;
   const bool was_ready = ready();
   // The rest test's line is taken on a full window only: after a restart its average starts afresh.
   if (n1 < line_span_ - 1) e_.line_ready = e_.window_ready = false;
   bool refreshed = false;
-  if (n1 >= k - 1 + 1) {
-    // D^kθ at the newest = D^{k−1} of the newest k differences.
-    Vec3 d = Vec3::Zero();
-    for (int j = 0; j < k; ++j) {
-      const double sign = ((k - 1 - j) % 2 == 0) ? 1.0 : -1.0;
-      d += sign * binomial(k - 1, j) * zeta[static_cast<std::size_t>(n1 - k + j)];
+  if (n1 >= low_.order) {
+    update_median(e_.low, newest_difference(zeta, low_).norm(), dt);
+    double s = std::exp(e_.low.log_median) * low_.sigma_per_median;
+    if (high_.order > 0 && n1 >= high_.order) {
+      update_median(e_.high, newest_difference(zeta, high_).norm(), dt);
+      // Once its exact start is complete: a median of a few values is not yet the noise's.
+      if (e_.high.settled()) s = std::min(s, kNoiseOrderMargin * std::exp(e_.high.log_median) * high_.sigma_per_median);
     }
-    update_noise(d.norm(), dt);
+    e_.noise_var = s * s;
   }
   // The noise each fit lets through, at the noise estimate just updated.
   const double fit_noise = e_.noise_var * fit_noise_gain_;
