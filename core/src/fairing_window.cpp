@@ -441,8 +441,11 @@ void FairingWindow::linear_emission_estimate(int k, double dt) {
 }
 
 // At rest, the channel's samples also feed a line with a memory of seconds (rest_line.hpp),
-// taken while no motion is seen (the heaviest level). Its coordinate is the sum of the
-// increments since it began, the linear solver's own (x_i = z_i exp(e_i), θ_i + e_i the path).
+// taken while no motion is seen (the heaviest level). Its coordinate: positions, the sum of the
+// increments since it began; rotations, the rotation from the rest's first pose, log(R⁻¹z). The
+// sum of rotation increments is not that rotation: each pair of noisy increments adds a term of
+// the order of their product, and over seconds of a noisy 1 kHz stream the terms walk far enough
+// to bend the line (test Adaptation.AStillPoseUnderHeavyNoiseIsAveragedToo).
 void FairingWindow::follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta) {
   const double memory = config_.adaptation.rest_memory_s;
   const bool still = ch.adaptive && prepared_ && memory > 0.0 && !(&ch == &rot_ && aided_) && n_ == w_ &&
@@ -451,10 +454,16 @@ void FairingWindow::follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta) {
     ch.rest.resting = false;
     return;
   }
+  const bool rotation = &ch == &rot_;
   auto feed = [&](int from) {
     for (int i = from; i < n_; ++i) {
       const auto j = static_cast<std::size_t>(i);
-      if (i > 0 && !ch.rest.line.empty()) ch.rest.theta += zeta[j - 1];
+      if (rotation) {
+        if (ch.rest.line.empty()) ch.rest.reference = z_[j];
+        ch.rest.theta = so3::log(ch.rest.reference.conjugate() * z_[j]);
+      } else if (i > 0 && !ch.rest.line.empty()) {
+        ch.rest.theta += zeta[j - 1];
+      }
       ch.rest.line.add(i > 0 ? samples_[j].time - samples_[j - 1].time : 0.0, ch.rest.theta, memory);
     }
     ch.rest.time = samples_[static_cast<std::size_t>(n_ - 1)].time;
@@ -500,6 +509,11 @@ Vec3 FairingWindow::rest_blend(Channel& ch, const SlidingArray<Vec3>& zeta, int 
   const double target = value->straight ? 1.0 : 0.0;
   ch.rest.weight += (target - ch.rest.weight) * (1.0 - std::exp(-std::max(dt, 0.0) / config_.adaptation.motion_time_s));
   if (!(ch.rest.weight > 0.0)) return window;
+  if (&ch == &rot_) {  // the line's pose, R·exp(line), in sample k's chart
+    const auto i = static_cast<std::size_t>(k);
+    const Vec3 line = so3::log(z_[i].conjugate() * (ch.rest.reference * so3::exp(value->line)));
+    return window + ch.rest.weight * (line - window);
+  }
   Vec3 theta_k = ch.rest.theta;
   for (int j = k; j < n_ - 1; ++j) theta_k -= zeta[static_cast<std::size_t>(j)];
   return window + ch.rest.weight * (value->line - theta_k - window);

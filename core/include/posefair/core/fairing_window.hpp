@@ -172,11 +172,13 @@ class FairingWindow {
     EmissionRow fixed;          // fixed μ: the full window's row
     MotionNoiseEstimator estimator;
     // At rest (adapted): the line through the samples since the rest began, its newest
-    // coordinate (the sum of the increments since then) and time, whether the channel is at
-    // rest now, the line's weight in the output, and whether the line is straight.
+    // coordinate (positions: the sum of the increments since then; rotations: log(R⁻¹z) from
+    // the rest's first pose R) and time, whether the channel is at rest now, the line's weight
+    // in the output, and whether the line is straight.
     struct Rest {
       RestLine line;
       Vec3 theta = Vec3::Zero();
+      Quat reference = Quat::Identity();  // rotations: R
       double time = 0.0;
       bool resting = false;
       double weight = 0.0;
