@@ -37,6 +37,22 @@ struct Stream {
   std::vector<Quat> truth;
 };
 
+// `seconds` of truth_at(t) at `rate`, each sample turned by a Gaussian rotation of `sigma` per
+// axis (physical angle), drawn from `seed`.
+template <class TruthAt>
+Stream with_noise(double rate, double seconds, double sigma, std::uint64_t seed, TruthAt&& truth_at) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, sigma);
+  Stream s;
+  for (int i = 0; i < static_cast<int>(seconds * rate); ++i) {
+    const double t = i / rate;
+    s.input.time.push_back(t);
+    s.truth.push_back(truth_at(t));
+    s.input.orientation.push_back(s.truth.back() * so3::from_rotation_vector(Vec3(noise(rng), noise(rng), noise(rng))));
+  }
+  return s;
+}
+
 // `seconds` of the motion at `rate`, each sample turned by a Gaussian rotation of `sigma`
 // per axis (physical angle).
 Stream sampled(double rate, double seconds, double sigma, double speed = 1.0, std::uint64_t seed = 3) {
@@ -361,17 +377,11 @@ TEST(Adaptation, ATremorIsNotTakenForNoise) {
   const double rate = 30.0, sigma = 0.0007;
   double raw = 0.0, out = 0.0, noise = 0.0;
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    std::mt19937_64 rng(seed);
-    std::normal_distribution<double> n(0.0, sigma);
-    Stream s;
-    for (int i = 0; i < static_cast<int>(20.0 * rate); ++i) {
-      const double t = i / rate;
+    const Stream s = with_noise(rate, 20.0, sigma, seed, [&](double t) {
       const double w = 2.0 * std::numbers::pi * t;
       const Vec3 tremor(0.02 * std::sin(7.0 * w + static_cast<double>(seed)), 0.015 * std::sin(6.1 * w + 1.0), 0.0);
-      s.truth.push_back(motion_at(t, 0.5) * so3::from_rotation_vector(tremor));
-      s.input.time.push_back(t);
-      s.input.orientation.push_back(s.truth.back() * so3::from_rotation_vector(Vec3(n(rng), n(rng), n(rng))));
-    }
+      return Quat(motion_at(t, 0.5) * so3::from_rotation_vector(tremor));
+    });
     const CausalResult r = fair_causal(s.input, WindowConfig{});
     ASSERT_TRUE(r.state.rotation.adaptive);
     raw += rms_error(s.input.orientation, s.truth, 60);
@@ -696,16 +706,7 @@ TEST(Adaptation, AVibrationIsNotTakenForRest) {
 // A slow turn with a fast shake (hz, amplitude amp rad) that comes and goes every 4 s, noise
 // sigma per axis: a hand-held controller shaken, a head shaken "no".
 Stream shaken(double rate, double hz, double amp, double sigma, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> noise(0.0, sigma);
-  Stream s;
-  for (int i = 0; i < static_cast<int>(16.0 * rate); ++i) {
-    const double t = i / rate;
-    s.input.time.push_back(t);
-    s.truth.push_back(shaken_at(t, hz, amp, seed));
-    s.input.orientation.push_back(s.truth.back() * so3::from_rotation_vector(Vec3(noise(rng), noise(rng), noise(rng))));
-  }
-  return s;
+  return with_noise(rate, 16.0, sigma, seed, [&](double t) { return shaken_at(t, hz, amp, seed); });
 }
 
 TEST(Adaptation, AFastShakeIsFollowedNotSmoothedAway) {
@@ -754,20 +755,14 @@ TEST(Adaptation, AQuickTurnIsTakenAtOnce) {
     SCOPED_TRACE(std::to_string(rate) + " Hz, turns of " + std::to_string(seconds) + " s");
     double raw = 0.0, smoothed = 0.0;
     for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-      std::mt19937_64 rng(seed);
-      std::normal_distribution<double> noise(0.0, sigma);
-      Stream s;
-      for (int i = 0; i < static_cast<int>(20.0 * rate); ++i) {
-        const double t = i / rate;
+      const Stream s = with_noise(rate, 20.0, sigma, seed, [&](double t) {
         double yaw = 0.0;
         for (int k = 0; k < 10; ++k) {
           const double u = std::clamp((t - 1.0 - 2.0 * k - 0.3 * std::sin(static_cast<double>(seed + k))) / seconds, 0.0, 1.0);
           yaw += (k % 2 ? -1.0 : 1.0) * std::numbers::pi / 3.0 * u * u * (3.0 - 2.0 * u);
         }
-        s.truth.push_back(so3::from_rotation_vector(Vec3(0.05 * std::sin(0.7 * t + static_cast<double>(seed)), 0.03 * std::sin(1.1 * t), yaw)));
-        s.input.time.push_back(t);
-        s.input.orientation.push_back(s.truth.back() * so3::from_rotation_vector(Vec3(noise(rng), noise(rng), noise(rng))));
-      }
+        return so3::from_rotation_vector(Vec3(0.05 * std::sin(0.7 * t + static_cast<double>(seed)), 0.03 * std::sin(1.1 * t), yaw));
+      });
       raw += rms_error_between(s, s.input.orientation, 1.0, 20.0);
       smoothed += rms_error_between(s, fair_causal(s.input, WindowConfig{}).poses.orientation, 1.0, 20.0);
     }
