@@ -121,8 +121,8 @@ class MotionNoiseEstimator {
   // The noise estimate also reads the differences this many orders above m + 2, and takes the
   // smaller σ² of the two: white noise fills every order alike, while a motion's share falls
   // from one order to the next wherever it lies below 0.4 of the rate (a 5–9 Hz tremor at 30
-  // Hz, a handheld camera) and grows only nearer Nyquist. Read at m + 2 alone, a 0.02 rad
-  // tremor at 30 Hz under 0.002 rad of noise passed for noise 2.7 times too large.
+  // Hz, a handheld camera) and grows only nearer Nyquist. Read at m + 2 alone, a 6–7 Hz tremor
+  // of 0.02 rad at 30 Hz under noise of 0.0007 rad per axis read as 5.7 times that noise.
   static constexpr int kNoiseOrderAbove = 3;
   // ... its σ counted at this many times its value: two estimates of one white noise differ by
   // their sampling spread, and the smaller of the two is biased low (taken plainly, still
@@ -169,7 +169,7 @@ class MotionNoiseEstimator {
   int span() const { return span_; }
 
  private:
-  // Takes ‖D^kθ‖ into the median m at order k.
+  // Takes a length ‖D^kθ‖ into the tracker of its order's median.
   void update_median(Estimates::LengthMedian& m, double length, double dt) const;
   // The least motion assumed while moving: the noise the fit lets through, or less where the
   // window's fit sees the motion is smaller.
