@@ -594,16 +594,15 @@ TEST(Adaptation, AStillPoseUnderHeavyNoiseIsAveragedToo) {
   off.adaptation.rest_memory_s = 0.0;
   double on_sq = 0.0, off_sq = 0.0;
   int averaged = 0, scored = 0;
+  const Quat truth = so3::from_rotation_vector(Vec3(0.4, -1.0, 2.0));
   for (std::uint64_t seed = 1; seed <= 2; ++seed) {
-    std::mt19937_64 rng(seed);
-    std::normal_distribution<double> n(0.0, sigma);
-    const Quat truth = so3::from_rotation_vector(Vec3(0.4, -1.0, 2.0));
+    const Stream s = with_noise(rate, 8.0, sigma, seed, [&](double) { return truth; });
     FairingWindow a{WindowConfig{}}, b(off);
     std::vector<FairedPose> out(1);
-    for (int i = 0; i < static_cast<int>(8.0 * rate); ++i) {
+    for (std::size_t i = 0; i < s.input.size(); ++i) {
       Sample x;
-      x.time = i / rate;
-      x.orientation = truth * so3::from_rotation_vector(Vec3(n(rng), n(rng), n(rng)));
+      x.time = s.input.time[i];
+      x.orientation = s.input.orientation[i];
       ASSERT_EQ(a.push(x, out), 1);
       const double on = so3::rotation_angle(out[0].orientation, truth);
       ASSERT_EQ(b.push(x, out), 1);
