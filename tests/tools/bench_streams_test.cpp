@@ -50,7 +50,10 @@ TEST(BenchStreams, TheDefaultsBeatRawOnEveryQuickStreamAndTheBestIsNoWorseThanTh
     const double raw = std::stod(f[4]), fair = std::stod(f[5]), best = std::stod(f[7]);
     // Sway and turns at 30 and 100 Hz under noise of 0.01 rad: 4–36% below raw (measured).
     EXPECT_LT(fair, raw);
-    EXPECT_LE(best, fair) << "the default is one of posefair's configurations";
+    // The default is one of posefair's configurations, run again: each run's delivery times
+    // add its own measured processing time, so under load the two differ in the last digits
+    // (a run of ctest beside a benchmark failed this by comparing them exactly).
+    EXPECT_LE(best, fair * (1.0 + 1e-4)) << "the default is one of posefair's configurations";
     EXPECT_LT(std::stod(f[12]), std::stod(f[11])) << "jitter";
     ++rows;
   }
