@@ -183,6 +183,8 @@ class FairingWindow {
       bool resting = false;
       double weight = 0.0;
       bool averaged = false;
+      bool departing = false;        // the newest sample left the line (departs_from_rest)
+      Vec3 departure = Vec3::Zero();  // by this much
     } rest;
   };
   // What a channel's adaptation had learnt before a held sample went in: put back when the next
@@ -211,8 +213,11 @@ class FairingWindow {
   void prepare(double rate_hz);
   void slide(int count);
   void adapt(Channel& ch, std::span<const Vec3> zeta, double dt);
+  enum class Departure { None, Off, Moving };
+  Departure departs_from_rest(Channel& ch, const SlidingArray<Vec3>& zeta);
+  char newest_held_ = 0;  // the channels whose newest sample the guard held (kHeld*; at lag 0 emitted as measured all the same)
   Vec3 linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c);
-  void follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta);
+  void follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta, bool departs);
   Vec3 rest_blend(Channel& ch, const SlidingArray<Vec3>& zeta, int k, const Vec3& window, double dt);
   void linear_emission_estimate(int k, double dt);
   void predict_from_last_step(int k, double step);

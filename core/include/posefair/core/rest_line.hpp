@@ -23,6 +23,12 @@ namespace posefair {
 // At 2, still streams kept less of the gain (18% instead of 23% less error at 100 Hz); at 4 a
 // slow sway at 30 Hz (0.5 Hz, 0.01 rad under noise of 0.01) lost 1.6% instead of 0.2%.
 inline constexpr double kRestLineFactor = 3.0;
+// A sample that lands off the line's prediction by a mean square per component over this many
+// times the noise is off the still pose (FairingWindow keeps it out of the line, and emits the
+// second of two in a row as measured): Gaussian noise puts it there once in 14 million samples
+// (a χ² with 3 degrees of freedom over 36). At 8, heavy-tailed noise (Student's t, 4 degrees of
+// freedom) at 1 kHz nearly tripled a still stream's jitter.
+inline constexpr double kRestDepartureFactor = 12.0;
 
 class RestLine {
  public:
