@@ -462,10 +462,10 @@ FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch, const Sli
     return Departure::None;
   const auto newest = static_cast<std::size_t>(n_ - 1);
   const double noise = ch.estimator.noise_variance();
-  const std::optional<RestLine::Value> value = ch.rest.line.value_at(ch.rest.time - samples_[newest].time, noise, kRestLineFactor);
-  if (!value) return Departure::None;
-  const Vec3 e = &ch == &rot_ ? so3::log((ch.rest.reference * so3::exp(value->line)).conjugate() * z_[newest])
-                              : Vec3(ch.rest.theta + zeta[newest - 1] - value->line);
+  const std::optional<Vec3> line = ch.rest.line.line_at(ch.rest.time - samples_[newest].time);
+  if (!line) return Departure::None;
+  // In the line's own coordinate (rotations: log(R⁻¹z), which the line is fitted to).
+  const Vec3 e = (&ch == &rot_ ? so3::log(ch.rest.reference.conjugate() * z_[newest]) : Vec3(ch.rest.theta + zeta[newest - 1])) - *line;
   if (!(e.squaredNorm() / 3.0 > kRestDepartureFactor * noise)) return Departure::None;
   const bool again = previous && e.dot(ch.rest.departure) > 0.5 * ch.rest.departure.squaredNorm();
   ch.rest.departing = true;

@@ -67,6 +67,15 @@ void RestLine::add(double dt, const Vec3& y, double memory_s) {
   values_[0] += y;
 }
 
+std::optional<Vec3> RestLine::line_at(double age) const {
+  // The 2×2 normal equations of the line, solved in closed form: [w0 w1; w1 w2]·p = [1, age].
+  if (steps_ < 2) return std::nullopt;
+  const double w0 = weights_[0], w1 = weights_[1], w2 = weights_[2];
+  const double det = w0 * w2 - w1 * w1;
+  if (!(det > 1e-12 * w0 * w2)) return std::nullopt;
+  return ((w2 - w1 * age) * values_[0] + (w0 * age - w1) * values_[1]) / det;
+}
+
 std::optional<RestLine::Value> RestLine::value_at(double age, double noise_var, double factor) const {
   // Each fit's value at `age` is Σ w_i·(pᵀ[1, a_i, a_i²])·y_i with p = M⁻¹[1, age, age²] and M
   // the fit's moments; the difference of the two fits has weights w_i·dᵀ[1, a_i, a_i²] with
