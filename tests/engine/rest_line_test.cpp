@@ -52,6 +52,10 @@ TEST(RestLine, IsTheWeightedLeastSquaresLineThroughItsSamples) {
     const std::optional<RestLine::Value> v = line.value_at(age, 1.0, kRestLineFactor);
     ASSERT_TRUE(v.has_value());
     EXPECT_LT((v->line - direct_line(t, y, 1.0, age)).norm(), 1e-9);
+    // The line alone, from its 2×2 equations in closed form (the rest departure test's).
+    const std::optional<Vec3> l = line.line_at(age);
+    ASSERT_TRUE(l.has_value());
+    EXPECT_LT((*l - direct_line(t, y, 1.0, age)).norm(), 1e-9);
   }
 }
 
@@ -99,8 +103,10 @@ TEST(RestLine, NeedsThreeDistinctTimes) {
   line.add(0.0, Vec3::Ones(), 1.0);  // a duplicate time stamp
   line.add(0.01, Vec3::Ones(), 1.0);
   EXPECT_FALSE(line.value_at(0.0, 1.0, kRestLineFactor).has_value());
+  EXPECT_FALSE(line.line_at(0.0).has_value());
   line.add(0.01, Vec3::Ones(), 1.0);
   EXPECT_TRUE(line.value_at(0.0, 1.0, kRestLineFactor).has_value());
+  EXPECT_TRUE(line.line_at(0.0).has_value());
   line.reset();
   EXPECT_TRUE(line.empty());
 }
