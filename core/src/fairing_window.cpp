@@ -431,20 +431,20 @@ EngineState FairingWindow::state() const {
 void FairingWindow::linear_emission_estimate(int k, double dt) {
   const auto d = static_cast<std::size_t>(std::max(0, n_ - 1));
   // Tested on the rest line before the newest sample goes into it.
-  const Departure rot_departs = k == n_ - 1 ? departs_from_rest(rot_, rotation_increments()) : Departure::None;
-  const Departure pos_departs = positions_ && k == n_ - 1 ? departs_from_rest(pos_, dzp_) : Departure::None;
+  const Departure rot_departs = k == n_ - 1 ? departs_from_rest(rot_) : Departure::None;
+  const Departure pos_departs = positions_ && k == n_ - 1 ? departs_from_rest(pos_) : Departure::None;
   adapt(rot_, std::span<const Vec3>(rotation_increments()).first(d), dt);
   if (positions_) adapt(pos_, std::span<const Vec3>(dzp_).first(d), dt);
-  follow_rest(rot_, rotation_increments(), rot_departs != Departure::None);
-  if (positions_) follow_rest(pos_, dzp_, pos_departs != Departure::None);
+  follow_rest(rot_, rot_departs != Departure::None);
+  if (positions_) follow_rest(pos_, pos_departs != Departure::None);
   if (k < 0) return;
   const auto i = static_cast<std::size_t>(k);
   // A motion leaving rest goes out as measured (k is the newest sample, and there is no horizon).
   est_[i] = rot_departs == Departure::Moving ? Vec3::Zero()
-                                              : rest_blend(rot_, rotation_increments(), k, linear_correction(rot_, rotation_increments(), c_), dt);
+                                              : rest_blend(rot_, k, linear_correction(rot_, rotation_increments(), c_), dt);
   if (positions_)
     xp_[i] = zp_[i] + (pos_departs == Departure::Moving ? Vec3::Zero()
-                                                        : rest_blend(pos_, dzp_, k, linear_correction(pos_, dzp_, cp_), dt));
+                                                        : rest_blend(pos_, k, linear_correction(pos_, dzp_, cp_), dt));
 }
 
 // At rest on the rest line: where the newest sample (not held) lands from the line's prediction
@@ -454,7 +454,7 @@ void FairingWindow::linear_emission_estimate(int k, double dt) {
 // pose until the motion estimate takes the motion, after its fit has stood over the onset
 // threshold twice. Not while predicting: the level-0 prediction carries one noisy step over the
 // horizon, worse than the line (quality benchmark, rests set at 20 ms: +0.9%).
-FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch, const SlidingArray<Vec3>& zeta) {
+FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch) {
   const bool previous = ch.rest.departing;
   ch.rest.departing = false;
   const char held = &ch == &rot_ ? kHeldRotation : kHeldPosition;
@@ -464,8 +464,7 @@ FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch, const Sli
   const double noise = ch.estimator.noise_variance();
   const std::optional<Vec3> line = ch.rest.line.line_at(ch.rest.time - samples_[newest].time);
   if (!line) return Departure::None;
-  // In the line's own coordinate (rotations: log(R⁻¹z), which the line is fitted to).
-  const Vec3 e = (&ch == &rot_ ? so3::log(ch.rest.reference.conjugate() * z_[newest]) : Vec3(ch.rest.theta + zeta[newest - 1])) - *line;
+  const Vec3 e = rest_coordinate(ch, n_ - 1) - *line;
   if (!(e.squaredNorm() / 3.0 > kRestDepartureFactor * noise)) return Departure::None;
   const bool again = previous && e.dot(ch.rest.departure) > 0.5 * ch.rest.departure.squaredNorm();
   ch.rest.departing = true;
@@ -473,13 +472,19 @@ FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch, const Sli
   return again ? Departure::Moving : Departure::Off;
 }
 
+// Sample j in the rest line's coordinate, from the rest's first sample: positions, p_j − p_0;
+// rotations, log(R⁻¹z_j) with R its pose. Not the sum of the rotation increments since then:
+// each pair of noisy increments adds a term of the order of their product, and over seconds of
+// a noisy 1 kHz stream the terms walk far enough to bend the line (test
+// Adaptation.AStillPoseUnderHeavyNoiseIsAveragedToo).
+Vec3 FairingWindow::rest_coordinate(const Channel& ch, int j) const {
+  const auto i = static_cast<std::size_t>(j);
+  return &ch == &rot_ ? so3::log(ch.rest.reference.conjugate() * z_[i]) : Vec3(zp_[i] - ch.rest.origin);
+}
+
 // At rest, the channel's samples also feed a line with a memory of seconds (rest_line.hpp),
-// taken while no motion is seen (the heaviest level). Its coordinate: positions, the sum of the
-// increments since it began; rotations, the rotation from the rest's first pose, log(R⁻¹z). The
-// sum of rotation increments is not that rotation: each pair of noisy increments adds a term of
-// the order of their product, and over seconds of a noisy 1 kHz stream the terms walk far enough
-// to bend the line (test Adaptation.AStillPoseUnderHeavyNoiseIsAveragedToo).
-void FairingWindow::follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta, bool departs) {
+// taken while no motion is seen (the heaviest level), in rest_coordinate.
+void FairingWindow::follow_rest(Channel& ch, bool departs) {
   const double memory = config_.adaptation.rest_memory_s;
   const bool still = ch.adaptive && prepared_ && memory > 0.0 && !(&ch == &rot_ && aided_) && n_ == w_ &&
                      ch.estimator.at_rest();
@@ -487,19 +492,18 @@ void FairingWindow::follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta, boo
     ch.rest.resting = false;
     return;
   }
-  const bool rotation = &ch == &rot_;
   auto feed = [&](int from) {
     for (int i = from; i < n_; ++i) {
       const auto j = static_cast<std::size_t>(i);
-      if (rotation) {
-        if (ch.rest.line.empty()) ch.rest.reference = z_[j];
-        ch.rest.theta = so3::log(ch.rest.reference.conjugate() * z_[j]);
-      } else if (i > 0 && !ch.rest.line.empty()) {
-        ch.rest.theta += zeta[j - 1];
+      const bool first = ch.rest.line.empty();
+      if (first) {
+        ch.rest.reference = z_[j];
+        if (&ch == &pos_) ch.rest.origin = zp_[j];
       }
-      ch.rest.line.add(i > 0 ? samples_[j].time - samples_[j - 1].time : 0.0, ch.rest.theta, memory);
+      // From the last sample the line took (a sample off it is skipped).
+      ch.rest.line.add(first ? 0.0 : samples_[j].time - ch.rest.time, rest_coordinate(ch, i), memory);
+      ch.rest.time = samples_[j].time;
     }
-    ch.rest.time = samples_[static_cast<std::size_t>(n_ - 1)].time;
   };
   if (ch.rest.resting) {
     if (!departs) feed(n_ - 1);  // a sample that left the still pose is no part of it
@@ -516,7 +520,6 @@ void FairingWindow::follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta, boo
   const std::optional<RestLine::Value> value = ch.rest.line.value_at(0.0, ch.estimator.noise_variance(), kRestLineFactor);
   if (last < 0 || !value || !value->straight) {
     ch.rest.line.reset();
-    ch.rest.theta = Vec3::Zero();
     feed(0);
   }
   ch.rest.resting = true;
@@ -526,10 +529,10 @@ void FairingWindow::follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta, boo
 // rest line's while the line is straight, and back while it is not, over motion_time_s (a
 // switch would step the output, and a stream at the edge of rest switches often). A motion
 // seen at rest takes the window's at once, as leaving rest does.
-Vec3 FairingWindow::rest_blend(Channel& ch, const SlidingArray<Vec3>& zeta, int k, const Vec3& window, double dt) {
+Vec3 FairingWindow::rest_blend(Channel& ch, int k, const Vec3& window, double dt) {
   ch.rest.averaged = false;
-  const auto newest = static_cast<std::size_t>(n_ - 1);
-  const double age = samples_[newest].time - samples_[static_cast<std::size_t>(k)].time - config_.horizon_s;
+  // The line's ages count from the last sample it took (the newest, unless that one was off it).
+  const double age = ch.rest.time - samples_[static_cast<std::size_t>(k)].time - config_.horizon_s;
   const std::optional<RestLine::Value> value =
       ch.rest.resting && ch.estimator.motion_variance() == 0.0
           ? ch.rest.line.value_at(age, ch.estimator.noise_variance(), kRestLineFactor)
@@ -547,9 +550,7 @@ Vec3 FairingWindow::rest_blend(Channel& ch, const SlidingArray<Vec3>& zeta, int 
     const Vec3 line = so3::log(z_[i].conjugate() * (ch.rest.reference * so3::exp(value->line)));
     return window + ch.rest.weight * (line - window);
   }
-  Vec3 theta_k = ch.rest.theta;
-  for (int j = k; j < n_ - 1; ++j) theta_k -= zeta[static_cast<std::size_t>(j)];
-  return window + ch.rest.weight * (value->line - theta_k - window);
+  return window + ch.rest.weight * (value->line - rest_coordinate(ch, k) - window);
 }
 
 // Constant angular (and linear) velocity from the last accepted measurement to the newest,

@@ -171,14 +171,14 @@ class FairingWindow {
     double level = 0.0;         // adapted: real index into levels_
     EmissionRow fixed;          // fixed μ: the full window's row
     MotionNoiseEstimator estimator;
-    // At rest (adapted): the line through the samples since the rest began, its newest
-    // coordinate (positions: the sum of the increments since then; rotations: log(R⁻¹z) from
-    // the rest's first pose R) and time, whether the channel is at rest now, the line's weight
-    // in the output, and whether the line is straight.
+    // At rest (adapted): the line through the samples since the rest began (in
+    // rest_coordinate, from the rest's first pose R or position p_0), the time of the last
+    // sample it took, whether the channel is at rest now, the line's weight in the output, and
+    // whether the line is straight.
     struct Rest {
       RestLine line;
-      Vec3 theta = Vec3::Zero();
       Quat reference = Quat::Identity();  // rotations: R
+      Vec3 origin = Vec3::Zero();         // positions: p_0
       double time = 0.0;
       bool resting = false;
       double weight = 0.0;
@@ -214,11 +214,12 @@ class FairingWindow {
   void slide(int count);
   void adapt(Channel& ch, std::span<const Vec3> zeta, double dt);
   enum class Departure { None, Off, Moving };
-  Departure departs_from_rest(Channel& ch, const SlidingArray<Vec3>& zeta);
+  Departure departs_from_rest(Channel& ch);
+  Vec3 rest_coordinate(const Channel& ch, int j) const;
   char newest_held_ = 0;  // the channels whose newest sample the guard held (kHeld*; at lag 0 emitted as measured all the same)
   Vec3 linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c);
-  void follow_rest(Channel& ch, const SlidingArray<Vec3>& zeta, bool departs);
-  Vec3 rest_blend(Channel& ch, const SlidingArray<Vec3>& zeta, int k, const Vec3& window, double dt);
+  void follow_rest(Channel& ch, bool departs);
+  Vec3 rest_blend(Channel& ch, int k, const Vec3& window, double dt);
   void linear_emission_estimate(int k, double dt);
   void predict_from_last_step(int k, double step);
   void check_continuity_stability() const;
