@@ -34,7 +34,7 @@ class RestLine {
  public:
   void reset();
   bool empty() const { return weights_[0] == 0.0; }
-  // A sample y (one channel's coordinate: the sum of its increments since rest began) taken dt
+  // A sample y (one channel's coordinate from the rest's first sample) taken dt
   // seconds after the last one.
   void add(double dt, const Vec3& y, double memory_s);
   // The line's value `age` seconds before the newest sample (negative: after it, a
