@@ -455,8 +455,8 @@ void FairingWindow::linear_emission_estimate(int k, double dt) {
 // threshold twice. Not while predicting: the level-0 prediction carries one noisy step over the
 // horizon, worse than the line (quality benchmark, rests set at 20 ms: +0.9%).
 FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch) {
-  const bool previous = ch.rest.departing;
-  ch.rest.departing = false;
+  const Vec3 before = ch.rest.departure;  // zero unless the sample before was off the line
+  ch.rest.departure = Vec3::Zero();
   const char held = &ch == &rot_ ? kHeldRotation : kHeldPosition;
   if (config_.horizon_s > 0.0 || !ch.adaptive || !ch.rest.resting || n_ != w_ || (newest_held_ & held) != 0)
     return Departure::None;
@@ -466,10 +466,8 @@ FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch) {
   if (!line) return Departure::None;
   const Vec3 e = rest_coordinate(ch, n_ - 1) - *line;
   if (!(e.squaredNorm() / 3.0 > kRestDepartureFactor * noise)) return Departure::None;
-  const bool again = previous && e.dot(ch.rest.departure) > 0.5 * ch.rest.departure.squaredNorm();
-  ch.rest.departing = true;
   ch.rest.departure = e;
-  return again ? Departure::Moving : Departure::Off;
+  return e.dot(before) > 0.5 * before.squaredNorm() ? Departure::Moving : Departure::Off;
 }
 
 // Sample j in the rest line's coordinate, from the rest's first sample: positions, p_j − p_0;

@@ -67,13 +67,19 @@ void RestLine::add(double dt, const Vec3& y, double memory_s) {
   values_[0] += y;
 }
 
-std::optional<Vec3> RestLine::line_at(double age) const {
+std::optional<std::array<double, 2>> RestLine::line_weights(double age) const {
   // The 2×2 normal equations of the line, solved in closed form: [w0 w1; w1 w2]·p = [1, age].
-  if (steps_ < 2) return std::nullopt;
+  if (steps_ < 2) return std::nullopt;  // fewer than three distinct times (value_at's quadratic has none)
   const double w0 = weights_[0], w1 = weights_[1], w2 = weights_[2];
   const double det = w0 * w2 - w1 * w1;
   if (!(det > 1e-12 * w0 * w2)) return std::nullopt;
-  return ((w2 - w1 * age) * values_[0] + (w0 * age - w1) * values_[1]) / det;
+  return std::array<double, 2>{(w2 - w1 * age) / det, (w0 * age - w1) / det};
+}
+
+std::optional<Vec3> RestLine::line_at(double age) const {
+  const std::optional<std::array<double, 2>> p = line_weights(age);
+  if (!p) return std::nullopt;
+  return (*p)[0] * values_[0] + (*p)[1] * values_[1];
 }
 
 std::optional<RestLine::Value> RestLine::value_at(double age, double noise_var, double factor) const {
@@ -84,12 +90,10 @@ std::optional<RestLine::Value> RestLine::value_at(double age, double noise_var, 
   const Eigen::Matrix3d quadratic = moments(weights_, 3);
   const Eigen::LDLT<Eigen::Matrix3d> q(quadratic);
   if (q.info() != Eigen::Success || !(q.rcond() > 1e-12)) return std::nullopt;
-  const Eigen::Matrix3d line = moments(weights_, 2);
-  const Eigen::LDLT<Eigen::Matrix3d> l(line);
-  const Eigen::Vector3d at(1.0, age, age * age);
-  const Eigen::Vector3d p_quadratic = q.solve(at);
-  Eigen::Vector3d p_line = l.solve(Eigen::Vector3d(1.0, age, 0.0));
-  p_line(2) = 0.0;
+  const std::optional<std::array<double, 2>> line = line_weights(age);
+  if (!line) return std::nullopt;
+  const Eigen::Vector3d p_line((*line)[0], (*line)[1], 0.0);
+  const Eigen::Vector3d p_quadratic = q.solve(Eigen::Vector3d(1.0, age, age * age));
   const Eigen::Vector3d d = p_quadratic - p_line;
   const double gain = d.dot(moments(squares_, 3) * d);
   const Vec3 difference = d(0) * values_[0] + d(1) * values_[1] + d(2) * values_[2];

@@ -183,8 +183,7 @@ class FairingWindow {
       bool resting = false;
       double weight = 0.0;
       bool averaged = false;
-      bool departing = false;        // the newest sample left the line (departs_from_rest)
-      Vec3 departure = Vec3::Zero();  // by this much
+      Vec3 departure = Vec3::Zero();  // how far the newest sample left the line (zero: it did not)
     } rest;
   };
   // What a channel's adaptation had learnt before a held sample went in: put back when the next

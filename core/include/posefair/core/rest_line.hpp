@@ -52,6 +52,8 @@ class RestLine {
   std::optional<Vec3> line_at(double age) const;
 
  private:
+  // The line's weights on Σw·y and Σw·a·y for its value at `age` (both of the above take it).
+  std::optional<std::array<double, 2>> line_weights(double age) const;
   std::array<double, 5> weights_{};  // Σ w·a^k, k = 0..4 (a: age in seconds)
   std::array<double, 5> squares_{};  // Σ w²·a^k: the noise the fits' weights carry
   std::array<Vec3, 3> values_{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};  // Σ w·a^k·y, k = 0..2
