@@ -543,12 +543,12 @@ Vec3 FairingWindow::rest_blend(Channel& ch, int k, const Vec3& window, double dt
   const double target = value->straight ? 1.0 : 0.0;
   ch.rest.weight += (target - ch.rest.weight) * (1.0 - std::exp(-std::max(dt, 0.0) / config_.adaptation.motion_time_s));
   if (!(ch.rest.weight > 0.0)) return window;
-  if (&ch == &rot_) {  // the line's pose, R·exp(line), in sample k's chart
+  if (&ch == &rot_) {  // the still pose, R·exp(pose), in sample k's chart
     const auto i = static_cast<std::size_t>(k);
-    const Vec3 line = so3::log(z_[i].conjugate() * (ch.rest.reference * so3::exp(value->line)));
-    return window + ch.rest.weight * (line - window);
+    const Vec3 still = so3::log(z_[i].conjugate() * (ch.rest.reference * so3::exp(value->pose)));
+    return window + ch.rest.weight * (still - window);
   }
-  return window + ch.rest.weight * (value->line - rest_coordinate(ch, k) - window);
+  return window + ch.rest.weight * (value->pose - rest_coordinate(ch, k) - window);
 }
 
 // Constant angular (and linear) velocity from the last accepted measurement to the newest,
