@@ -94,18 +94,19 @@ std::optional<RestLine::Value> RestLine::value_at(double age, double noise_var, 
   if (!line) return std::nullopt;
   const Eigen::Vector3d p_line((*line)[0], (*line)[1], 0.0);
   const Eigen::Vector3d p_quadratic = q.solve(Eigen::Vector3d(1.0, age, age * age));
-  const Eigen::Matrix3d squares = moments(squares_, 3);
   const Eigen::Vector3d d = p_quadratic - p_line;
-  const double gain = d.dot(squares * d);
+  const double gain = d.dot(moments(squares_, 3) * d);
   const Vec3 difference = d(0) * values_[0] + d(1) * values_[1] + d(2) * values_[2];
   const Vec3 line_value = p_line(0) * values_[0] + p_line(1) * values_[1];
   // Moved toward the level by w = −C/(V + b²), the weight with the least expected square error:
   // C the covariance of the line's noise with the level-minus-line difference's, V that
   // difference's noise, b² its bias, taken as kLevelBiasFactor times its mean square.
-  const Eigen::Vector3d e = Eigen::Vector3d(1.0 / weights_[0], 0.0, 0.0) - p_line;
-  const Vec3 level_minus_line = e(0) * values_[0] + e(1) * values_[1];
-  const double noise = e.dot(squares * e) * noise_var;
-  const double covariance = p_line.dot(squares * e) * noise_var;
+  // Both are lines in the samples' ages: weights (p0, p1) and (e0, e1) on Σw·y and Σw·a·y.
+  const double p0 = p_line(0), p1 = p_line(1), e0 = 1.0 / weights_[0] - p0, e1 = -p1;
+  const double s0 = squares_[0], s1 = squares_[1], s2 = squares_[2];
+  const Vec3 level_minus_line = e0 * values_[0] + e1 * values_[1];
+  const double noise = (e0 * e0 * s0 + 2.0 * e0 * e1 * s1 + e1 * e1 * s2) * noise_var;
+  const double covariance = (p0 * e0 * s0 + (p0 * e1 + p1 * e0) * s1 + p1 * e1 * s2) * noise_var;
   const double denominator = noise + kLevelBiasFactor * level_minus_line.squaredNorm() / 3.0;
   const double w = denominator > 0.0 ? std::clamp(-covariance / denominator, 0.0, 1.0) : 0.0;
   return Value{line_value + w * level_minus_line, difference.squaredNorm() / 3.0 < factor * noise_var * gain};
