@@ -262,7 +262,8 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
       if (settings_.motion_floor && settings_.rest_threshold > 0.0 && full) {
         const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return line_[static_cast<std::size_t>(j)]; },
                                            zeta.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
-        const double slope = v.squaredNorm() / 3.0;
+        const double leaves = kRestLeaveFactor * settings_.rest_threshold * e_.noise_var * line_noise_gain_;
+        const double slope = std::min(v.squaredNorm() / 3.0, kRestSlopeCap * leaves);
         e_.line_mean_square = e_.line_ready ? e_.line_mean_square + alpha * (slope - e_.line_mean_square) : slope;
         e_.line_ready = true;
       }

@@ -701,6 +701,48 @@ TEST(Adaptation, ATurnOutOfRestIsFollowedFromItsSecondSample) {
   }
 }
 
+TEST(Adaptation, ARestAfterATurnIsSeenSoon) {
+  // A turn (1.5 rad in 0.5 s), then still, under noise of 0.005 rad per axis. The rest test's line spans the window (0.5 s), so it
+  // sees the rest no sooner than the turn has left the window; its average of the slope's square
+  // then came down from the turn's 10⁴–10⁵ times the threshold at a factor e per time constant
+  // (0.1 s). Capped at 8 times the slope that leaves rest (kRestSlopeCap), it comes down in
+  // 0.28 s. The latest of 5 seeds, and the error over the next second against raw's: 1.33, 1.50
+  // and 1.51 s (0.82, 0.59, 0.43) uncapped at 30, 100 and 250 Hz; 0.90, 1.00 and 0.86 s (0.78,
+  // 0.58, 0.42) capped.
+  for (const auto& [rate, bound] : {std::pair{30.0, 0.8}, std::pair{100.0, 0.585}, std::pair{250.0, 0.425}}) {
+    SCOPED_TRACE(std::to_string(rate) + " Hz");
+    double latest = 0.0, error_sq = 0.0, raw_sq = 0.0;
+    int scored = 0;
+    for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+      const Stream s = with_noise(rate, 5.0, 0.005, seed, [](double t) {
+        const double u = std::clamp((t - 2.0) / 0.5, 0.0, 1.0);
+        return so3::from_rotation_vector(Vec3(0.0, 1.5 * u * u * (3.0 - 2.0 * u), 0.0));
+      });
+      FairingWindow w{WindowConfig{}};
+      std::vector<FairedPose> out(1);
+      double seen = -1.0;
+      for (std::size_t i = 0; i < s.input.size(); ++i) {
+        Sample x;
+        x.time = s.input.time[i];
+        x.orientation = s.input.orientation[i];
+        ASSERT_EQ(w.push(x, out), 1);
+        const bool at_rest = w.state().rotation.at_rest;
+        if (x.time > 2.5 && at_rest && seen < 0.0) seen = x.time - 2.5;
+        if (x.time > 2.5 && !at_rest) seen = -1.0;  // seen for good
+        if (x.time >= 2.6 && x.time < 3.5) {
+          error_sq += std::pow(so3::rotation_angle(out[0].orientation, s.truth[i]), 2);
+          raw_sq += std::pow(so3::rotation_angle(s.input.orientation[i], s.truth[i]), 2);
+          ++scored;
+        }
+      }
+      ASSERT_GE(seen, 0.0);
+      latest = std::max(latest, seen);
+    }
+    EXPECT_LT(latest, 1.15);
+    EXPECT_LT(std::sqrt(error_sq / raw_sq), bound);
+  }
+}
+
 TEST(Adaptation, ANoiseSpikeAtRestIsNotTakenForATurn) {
   // Heavy-tailed noise (Student's t, 4 degrees of freedom: a tracker's occasional bad frame)
   // puts a sample off the rest line now and then. Alone, it is no turn: it is kept out of the
