@@ -443,8 +443,11 @@ TEST(OutlierGuardInTheEngine, ABurstOfOutliersIsHeldWhole) {
     }
     // Rotation and position against the guard-free engine: at lag 0 0.69 and 0.84 (0.87 and
     // 0.91 before bursts were held, 0.79 and 0.88 with the rest of a burst emitted as measured),
-    // at lag 1 0.58 and 0.73 (0.83 and 0.82).
-    EXPECT_LT(rotation_rms(guarded), (lag == 0 ? 0.75 : 0.7) * rotation_rms(plain));
+    // at lag 1 0.58 and 0.73 (0.83 and 0.82). On 2026-12-06 the rotation's at lag 0 went to 0.75
+    // with the changes at rest that day and to 0.76 with a motion's stop taken at once
+    // (docs/engine.md), which brought the guard-free engine's error down more than the guarded
+    // one's (0.0181 → 0.0179 rad against 0.01358 → 0.01351).
+    EXPECT_LT(rotation_rms(guarded), (lag == 0 ? 0.8 : 0.7) * rotation_rms(plain));
     EXPECT_LT(position_rms(guarded), (lag == 0 ? 0.87 : 0.78) * position_rms(plain));
   }
 }
