@@ -701,8 +701,32 @@ TEST(Adaptation, ATurnOutOfRestIsFollowedFromItsSecondSample) {
   }
 }
 
+// A quick turn (1.5 rad about y in 0.5 s from t = 2 s, smoothstep in the angle), then still,
+// under noise of 0.005 rad per axis.
+Stream turn_then_still(double rate, double seconds, std::uint64_t seed) {
+  return with_noise(rate, seconds, 0.005, seed, [](double t) {
+    const double u = std::clamp((t - 2.0) / 0.5, 0.0, 1.0);
+    return so3::from_rotation_vector(Vec3(0.0, 1.5 * u * u * (3.0 - 2.0 * u), 0.0));
+  });
+}
+
+// The default engine run sample by sample over a stream's orientations; each pose is handed to
+// `visit` with its sample's index and the engine (for its state).
+template <class Visit>
+void each_default_pose(const Stream& s, Visit&& visit) {
+  FairingWindow w{WindowConfig{}};
+  std::vector<FairedPose> out(1);
+  for (std::size_t i = 0; i < s.input.size(); ++i) {
+    Sample x;
+    x.time = s.input.time[i];
+    x.orientation = s.input.orientation[i];
+    ASSERT_EQ(w.push(x, out), 1);
+    visit(i, out[0], w);
+  }
+}
+
 TEST(Adaptation, ARestAfterATurnIsSeenSoon) {
-  // A turn (1.5 rad in 0.5 s), then still, under noise of 0.005 rad per axis. The rest test's line spans the window (0.5 s), so it
+  // A turn, then still (turn_then_still). The rest test's line spans the window (0.5 s), so it
   // sees the rest no sooner than the turn has left the window; its average of the slope's square
   // then came down from the turn's 10⁴–10⁵ times the threshold at a factor e per time constant
   // (0.1 s). Capped at 8 times the slope that leaves rest (kRestSlopeCap), it comes down in
@@ -712,29 +736,19 @@ TEST(Adaptation, ARestAfterATurnIsSeenSoon) {
   for (const auto& [rate, bound] : {std::pair{30.0, 0.8}, std::pair{100.0, 0.585}, std::pair{250.0, 0.425}}) {
     SCOPED_TRACE(std::to_string(rate) + " Hz");
     double latest = 0.0, error_sq = 0.0, raw_sq = 0.0;
-    int scored = 0;
     for (std::uint64_t seed = 1; seed <= 5; ++seed) {
-      const Stream s = with_noise(rate, 5.0, 0.005, seed, [](double t) {
-        const double u = std::clamp((t - 2.0) / 0.5, 0.0, 1.0);
-        return so3::from_rotation_vector(Vec3(0.0, 1.5 * u * u * (3.0 - 2.0 * u), 0.0));
-      });
-      FairingWindow w{WindowConfig{}};
-      std::vector<FairedPose> out(1);
+      const Stream s = turn_then_still(rate, 5.0, seed);
       double seen = -1.0;
-      for (std::size_t i = 0; i < s.input.size(); ++i) {
-        Sample x;
-        x.time = s.input.time[i];
-        x.orientation = s.input.orientation[i];
-        ASSERT_EQ(w.push(x, out), 1);
+      each_default_pose(s, [&](std::size_t i, const FairedPose& pose, const FairingWindow& w) {
+        const double t = s.input.time[i];
         const bool at_rest = w.state().rotation.at_rest;
-        if (x.time > 2.5 && at_rest && seen < 0.0) seen = x.time - 2.5;
-        if (x.time > 2.5 && !at_rest) seen = -1.0;  // seen for good
-        if (x.time >= 2.6 && x.time < 3.5) {
-          error_sq += std::pow(so3::rotation_angle(out[0].orientation, s.truth[i]), 2);
+        if (t > 2.5 && at_rest && seen < 0.0) seen = t - 2.5;
+        if (t > 2.5 && !at_rest) seen = -1.0;  // seen for good
+        if (t >= 2.6 && t < 3.5) {
+          error_sq += std::pow(so3::rotation_angle(pose.orientation, s.truth[i]), 2);
           raw_sq += std::pow(so3::rotation_angle(s.input.orientation[i], s.truth[i]), 2);
-          ++scored;
         }
-      }
+      });
       ASSERT_GE(seen, 0.0);
       latest = std::max(latest, seen);
     }
@@ -754,19 +768,10 @@ TEST(Adaptation, AMotionStoppingIsTakenAtOnce) {
     SCOPED_TRACE(std::to_string(rate) + " Hz");
     double cutoff = 0.0;
     for (std::uint64_t seed = 1; seed <= 5; ++seed) {
-      const Stream s = with_noise(rate, 3.0, 0.005, seed, [](double t) {
-        const double u = std::clamp((t - 2.0) / 0.5, 0.0, 1.0);
-        return so3::from_rotation_vector(Vec3(0.0, 1.5 * u * u * (3.0 - 2.0 * u), 0.0));
+      const Stream s = turn_then_still(rate, 3.0, seed);
+      each_default_pose(s, [&](std::size_t i, const FairedPose&, const FairingWindow& w) {
+        if (std::abs(s.input.time[i] - 2.85) < 0.5 / rate) cutoff = std::max(cutoff, w.state().rotation.cutoff_hz);
       });
-      FairingWindow w{WindowConfig{}};
-      std::vector<FairedPose> out(1);
-      for (std::size_t i = 0; i < s.input.size(); ++i) {
-        Sample x;
-        x.time = s.input.time[i];
-        x.orientation = s.input.orientation[i];
-        ASSERT_EQ(w.push(x, out), 1);
-        if (std::abs(x.time - 2.85) < 0.5 / rate) cutoff = std::max(cutoff, w.state().rotation.cutoff_hz);
-      }
     }
     EXPECT_LT(cutoff, 6.0);
   }
