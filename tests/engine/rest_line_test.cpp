@@ -78,8 +78,9 @@ TEST(RestLine, IsTheWeightedLeastSquaresLineThroughItsSamples) {
 
 TEST(RestLine, AStillPoseIsTakenNearerTheLevel) {
   // On a still pose the level (the weighted mean) keeps 0.071σ of the noise where the line's
-  // newest value keeps 0.11σ (memory 1 s, 100 Hz, samples since long before). The still pose is moved toward the level as
-  // far as their difference allows, so it keeps less than the line and no less than the level.
+  // newest value keeps 0.11σ (memory 1 s, 100 Hz, samples since long before). The still pose is
+  // moved toward the level as far as their difference allows, so it keeps less than the line
+  // and no less than the level.
   std::mt19937_64 rng(5);
   const double sigma = 0.01;
   std::normal_distribution<double> noise(0.0, sigma);
