@@ -106,6 +106,7 @@ void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& s
   span_ = std::clamp(static_cast<int>(std::lround(settings.motion_span_s * rate_hz)), m + 1, std::max(m + 1, capacity_));
   span_ = std::min(span_, capacity_);
   fit_noise_gain_ = derivative_fit_weights(span_, m, fit_);
+  peak_half_s_ = 0.5 * span_ / rate_hz;
   // The fast part: the same fit over half the span (none where that is under m + 1 samples:
   // 10 Hz with the default span).
   short_span_ = span_ / 2 >= m + 1 ? span_ / 2 : 0;
@@ -267,6 +268,15 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
       }
       e_.onset_over = over;
       e_.onset_last = sample;
+      // The largest fit of the last half to whole span: a vibration's fit passes through zero
+      // twice a period, and stands over its noise only now and then.
+      e_.peak_s += e_.motion_pending_s;
+      if (e_.peak_s >= (1.0 - 1e-9) * peak_half_s_) {  // (less a rounding, as above)
+        e_.peak_before = e_.peak;
+        e_.peak = 0.0;
+        e_.peak_s = 0.0;
+      }
+      e_.peak = std::max(e_.peak, sample);
       const bool full = n1 >= line_span_ - 1;
       if (settings_.motion_floor && window_fit_noise_gain_ > 0.0 && full) {
         const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return window_fit_[static_cast<std::size_t>(j)]; },
@@ -293,8 +303,12 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
     const double line_noise = e_.noise_var * line_noise_gain_;
     e_.at_rest = settings_.motion_floor && threshold > 0.0 && e_.line_ready &&
                e_.line_mean_square < (e_.at_rest ? kRestLeaveFactor : 1.0) * threshold * line_noise;
+    // At rest the average counts only while a fit stands clear of the noise too: the newest
+    // (a motion starting) or one of the last span (a vibration).
+    const bool clear = e_.onset_last >= kRestMotionFitFactor * fit_noise ||
+                       std::max(e_.peak, e_.peak_before) >= kRestOnsetFactor * fit_noise;
     if (e_.at_rest)
-      e_.motion_var = e_.mean_square < threshold * fit_noise ? 0.0 : e_.mean_square - fit_noise;
+      e_.motion_var = e_.mean_square < threshold * fit_noise || !clear ? 0.0 : e_.mean_square - fit_noise;
     else
       e_.motion_var = std::max(motion_floor(fit_noise), e_.mean_square - fit_noise);
     // The fast part counts where it stands clear of the noise its fit lets through.

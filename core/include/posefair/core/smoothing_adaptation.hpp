@@ -108,6 +108,20 @@ class MotionNoiseEstimator {
   // the rest departure rule emitted more of its samples as measured: the jitter of quick turns
   // (`posefair bench streams`) rose by up to 22%, against 4% at 8.
   static constexpr double kRestSlopeCap = 8.0;
+  // At rest, the motion's average counts (over rest_threshold times the fit's noise) only while
+  // a fit stands clear of its noise too: the newest this many times over it (a motion starting),
+  // or one of the last half to whole span kRestOnsetFactor times (a vibration, whose fit passes
+  // through zero twice a period). The average of fits a few samples apart, which share most of
+  // their samples, crossed the threshold by chance under noise alone 12 to 33 times a minute at
+  // 10 Hz to 1 kHz, and each time the still pose went from the rest line to the window's few Hz
+  // at once: a twitch, and 1.4 to 1.8 times One Euro's error on a still stream (mincutoff
+  // 0.25 Hz). A motion starting puts its fits far over both: quick turns out of rest moved by 1%
+  // at most (`posefair bench streams`). The newest fit alone lost a vibration at rest
+  // (`Adaptation.AVibrationIsNotTakenForRest`); the span's largest fit alone at 8 took turns
+  // under heavy noise a sample later (+3.4% at 30 Hz), and at 6 kept less of the gain at rest
+  // at 120 Hz and up. The average alone over twice the threshold (4 times the noise) also saw
+  // turns start a sample later, and lost up to 7% on them.
+  static constexpr double kRestMotionFitFactor = 6.0;
   // At rest, a fit this many times over its noise, twice running and growing, is a motion
   // starting: the motion estimate takes it at once instead of averaging it in.
   static constexpr double kRestOnsetFactor = 8.0;
@@ -174,6 +188,9 @@ class MotionNoiseEstimator {
     bool onset_over = false;  // the last fit stood over the onset threshold
     double onset_last = 0.0;  // the last fit's mean square
     bool stop_last = false;   // the last fit stood within its noise after a clear motion
+    // The largest fit of the last half span and of the half span before it (in stream time), and
+    // the time the newer half has run: the largest fit of the last half to whole span.
+    double peak = 0.0, peak_before = 0.0, peak_s = 0.0;
   };
   const Estimates& estimates() const { return e_; }
   void restore(const Estimates& e) { e_ = e; }
@@ -201,6 +218,7 @@ class MotionNoiseEstimator {
   int span_ = 0;
   std::vector<double> fit_;      // weights on the span's span−1 differences
   double fit_noise_gain_ = 0.0;  // Σ of the fit's squared weights on θ
+  double peak_half_s_ = 0.0;     // half the fit's span (s): the blocks of Estimates::peak
   // The motion's fast part: the same fit over half the span (0: none), and its noise gain.
   int short_span_ = 0;
   std::vector<double> short_fit_;
