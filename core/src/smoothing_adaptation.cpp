@@ -303,14 +303,15 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
     const double line_noise = e_.noise_var * line_noise_gain_;
     e_.at_rest = settings_.motion_floor && threshold > 0.0 && e_.line_ready &&
                e_.line_mean_square < (e_.at_rest ? kRestLeaveFactor : 1.0) * threshold * line_noise;
-    // At rest the average counts only while a fit stands clear of the noise too: the newest
-    // (a motion starting) or one of the last span (a vibration).
-    const bool clear = e_.onset_last >= kRestMotionFitFactor * fit_noise ||
-                       std::max(e_.peak, e_.peak_before) >= kRestOnsetFactor * fit_noise;
-    if (e_.at_rest)
+    if (e_.at_rest) {
+      // The average counts only while a fit stands clear of the noise too: the newest (a motion
+      // starting) or one of the last span (a vibration).
+      const bool clear = e_.onset_last >= kRestMotionFitFactor * fit_noise ||
+                         std::max(e_.peak, e_.peak_before) >= kRestOnsetFactor * fit_noise;
       e_.motion_var = e_.mean_square < threshold * fit_noise || !clear ? 0.0 : e_.mean_square - fit_noise;
-    else
+    } else {
       e_.motion_var = std::max(motion_floor(fit_noise), e_.mean_square - fit_noise);
+    }
     // The fast part counts where it stands clear of the noise its fit lets through.
     if (short_span_ > 0 && e_.short_mean_square > kFastMotionFactor * short_noise)
       e_.motion_var = std::max(e_.motion_var, e_.short_mean_square - short_noise);
