@@ -184,7 +184,7 @@ double MotionNoiseEstimator::motion_floor(double fit_noise) const {
   return fit_noise;
 }
 
-bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
+bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::span<const Vec3> line_zeta) {
   const int n1 = static_cast<int>(zeta.size());  // differences available
   if (!(dt > 0.0)) return false;
   const bool was_ready = ready();
@@ -286,8 +286,9 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt) {
         e_.window_ready = true;
       }
       if (settings_.motion_floor && settings_.rest_threshold > 0.0 && full) {
+        const std::span<const Vec3> on = line_zeta.size() == zeta.size() ? line_zeta : zeta;
         const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return line_[static_cast<std::size_t>(j)]; },
-                                           zeta.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
+                                           on.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
         const double leaves = kRestLeaveFactor * settings_.rest_threshold * e_.noise_var * line_noise_gain_;
         const double slope = std::min(v.squaredNorm() / 3.0, kRestSlopeCap * leaves);
         e_.line_mean_square = e_.line_ready ? e_.line_mean_square + alpha * (slope - e_.line_mean_square) : slope;

@@ -212,6 +212,7 @@ class FairingWindow {
   void prepare(double rate_hz);
   void slide(int count);
   void adapt(Channel& ch, std::span<const Vec3> zeta, double dt);
+  std::span<const Vec3> rest_increments(int count);
   enum class Departure { None, Off, Moving };
   Departure departs_from_rest(Channel& ch);
   Vec3 rest_coordinate(const Channel& ch, int j) const;
@@ -291,6 +292,11 @@ class FairingWindow {
   SlidingArray<Quat> x_;           // current estimate (iterative solvers)
   SlidingArray<Vec3> zeta_;        // ζ_j = log(z_j⁻¹ z_{j+1}) (Linear)
   SlidingArray<Vec3> residual_;    // ζ_j − g_j, the gyro-aided increments (Linear, aided)
+  // At rest: log(R⁻¹z_{j+1}) − log(R⁻¹z_j) on the rest line's chart (R: its reference), for the
+  // rest test's line; valid while rest_chart_ready_, for rest_chart_reference_.
+  SlidingArray<Vec3> rest_zeta_;
+  Quat rest_chart_reference_ = Quat::Identity();
+  bool rest_chart_ready_ = false;
   SlidingArray<Vec3> est_;         // e_i: estimate x_i = z_i exp(e_i) (Linear)
   SlidingArray<Vec3> c_;           // log(z_i⁻¹ y_i) of emitted samples (Linear)
   SlidingArray<Vec3> dzp_;         // p_{j+1} − p_j (Linear)

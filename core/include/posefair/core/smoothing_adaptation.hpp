@@ -91,7 +91,10 @@ class MotionNoiseEstimator {
   // newest step (seconds). Differences across a window restart are never used. True when the
   // motion estimate was refreshed or ready() changed (a choice of level made from the estimates
   // before stays as good until then: the noise estimate moves by a step of dt/noise_time_s).
-  bool update(std::span<const Vec3> zeta, double dt);
+  // line_zeta, when as long as zeta: the same differences on a chart, which the rest test's
+  // line is fitted to instead (FairingWindow gives those of a rotation at rest: summed, the
+  // increments ζ carry second-order terms that walk under heavy noise).
+  bool update(std::span<const Vec3> zeta, double dt, std::span<const Vec3> line_zeta = {});
   static constexpr double kMotionRefreshes = 25.0;  // motion fits per motion_time_s, at most
   // A stream at rest stays at rest until the line's mean square is this many times the
   // threshold. The window's slope is correlated over the whole window, so under noise alone a
