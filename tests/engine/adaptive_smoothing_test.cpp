@@ -54,6 +54,25 @@ Stream with_noise(double rate, double seconds, double sigma, std::uint64_t seed,
   return s;
 }
 
+// An engine (the default's unless given) run sample by sample over a stream's orientations; each
+// pose is handed to `visit` with its sample's index and the engine (for its state).
+template <class Visit>
+void each_pose(const Stream& s, const WindowConfig& config, Visit&& visit) {
+  FairingWindow w(config);
+  std::vector<FairedPose> out(1);
+  for (std::size_t i = 0; i < s.input.size(); ++i) {
+    Sample x;
+    x.time = s.input.time[i];
+    x.orientation = s.input.orientation[i];
+    ASSERT_EQ(w.push(x, out), 1);
+    visit(i, out[0], w);
+  }
+}
+template <class Visit>
+void each_default_pose(const Stream& s, Visit&& visit) {
+  each_pose(s, WindowConfig{}, visit);
+}
+
 // `seconds` of the motion at `rate`, each sample turned by a Gaussian rotation of `sigma`
 // per axis (physical angle).
 Stream sampled(double rate, double seconds, double sigma, double speed = 1.0, std::uint64_t seed = 3) {
@@ -598,21 +617,15 @@ TEST(Adaptation, AStillPoseUnderHeavyNoiseIsAveragedToo) {
   const Quat truth = so3::from_rotation_vector(Vec3(0.4, -1.0, 2.0));
   for (std::uint64_t seed = 1; seed <= 2; ++seed) {
     const Stream s = with_noise(rate, 8.0, sigma, seed, [&](double) { return truth; });
-    FairingWindow a{WindowConfig{}}, b(off);
-    std::vector<FairedPose> out(1);
-    for (std::size_t i = 0; i < s.input.size(); ++i) {
-      Sample x;
-      x.time = s.input.time[i];
-      x.orientation = s.input.orientation[i];
-      ASSERT_EQ(a.push(x, out), 1);
-      const double on = so3::rotation_angle(out[0].orientation, truth);
-      ASSERT_EQ(b.push(x, out), 1);
-      if (x.time < 3.0) continue;
-      on_sq += on * on;
-      off_sq += std::pow(so3::rotation_angle(out[0].orientation, truth), 2);
-      averaged += a.state().rotation.rest_averaged ? 1 : 0;
+    each_default_pose(s, [&](std::size_t i, const FairedPose& pose, const FairingWindow& w) {
+      if (s.input.time[i] < 3.0) return;
+      on_sq += std::pow(so3::rotation_angle(pose.orientation, truth), 2);
+      averaged += w.state().rotation.rest_averaged ? 1 : 0;
       ++scored;
-    }
+    });
+    each_pose(s, off, [&](std::size_t i, const FairedPose& pose, const FairingWindow&) {
+      if (s.input.time[i] >= 3.0) off_sq += std::pow(so3::rotation_angle(pose.orientation, truth), 2);
+    });
   }
   EXPECT_GT(averaged, 0.8 * scored);
   EXPECT_LT(std::sqrt(on_sq / off_sq), 0.6) << "the rest line's gain over the window's smoothing";
@@ -709,21 +722,6 @@ Stream turn_then_still(double rate, double seconds, std::uint64_t seed) {
     const double u = std::clamp((t - 2.0) / 0.5, 0.0, 1.0);
     return so3::from_rotation_vector(Vec3(0.0, 1.5 * u * u * (3.0 - 2.0 * u), 0.0));
   });
-}
-
-// The default engine run sample by sample over a stream's orientations; each pose is handed to
-// `visit` with its sample's index and the engine (for its state).
-template <class Visit>
-void each_default_pose(const Stream& s, Visit&& visit) {
-  FairingWindow w{WindowConfig{}};
-  std::vector<FairedPose> out(1);
-  for (std::size_t i = 0; i < s.input.size(); ++i) {
-    Sample x;
-    x.time = s.input.time[i];
-    x.orientation = s.input.orientation[i];
-    ASSERT_EQ(w.push(x, out), 1);
-    visit(i, out[0], w);
-  }
 }
 
 TEST(Adaptation, ARestAfterATurnIsSeenSoon) {
