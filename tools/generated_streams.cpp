@@ -92,8 +92,11 @@ std::function<Quat(double)> walk(std::mt19937_64& rng, double seconds, double dt
 }  // namespace
 
 std::string GeneratedStreamSpec::name() const {
-  char b[96];
-  std::snprintf(b, sizeof b, "%s-%gHz-noise%g", motion.c_str(), rate_hz, noise);
+  char b[128];
+  if (source_hz > 0.0)
+    std::snprintf(b, sizeof b, "%s-%gHz-noise%g-from%gHz-%s", motion.c_str(), rate_hz, noise, source_hz, resampling.c_str());
+  else
+    std::snprintf(b, sizeof b, "%s-%gHz-noise%g", motion.c_str(), rate_hz, noise);
   return b;
 }
 
@@ -101,12 +104,14 @@ std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick) {
   std::vector<GeneratedStreamSpec> out;
   if (quick) {
     for (const char* motion : {"sway", "turns"})
-      for (double rate : {30.0, 100.0}) out.push_back({motion, rate, 0.01, 5.0});
+      for (double rate : {30.0, 100.0}) out.push_back({motion, rate, 0.01, 5.0, 0.0, {}});
     return out;
   }
   for (const char* motion : {"still", "sway", "turns", "shake", "walk"})
     for (double rate : {10.0, 30.0, 60.0, 120.0, 250.0, 1000.0})
-      for (double noise : {0.002, 0.01, 0.04}) out.push_back({motion, rate, noise, rate > 500.0 ? 10.0 : 20.0});
+      for (double noise : {0.002, 0.01, 0.04}) out.push_back({motion, rate, noise, rate > 500.0 ? 10.0 : 20.0, 0.0, {}});
+  for (const char* motion : {"still", "sway", "turns", "walk"})
+    for (const char* resampling : {"hold", "linear"}) out.push_back({motion, 250.0, 0.01, 20.0, 60.0, resampling});
   return out;
 }
 
@@ -135,10 +140,27 @@ QualitySequence generated_stream(const GeneratedStreamSpec& spec) {
   s.name = spec.name();
   s.rate_hz = spec.rate_hz;
   const auto n = static_cast<std::size_t>(spec.seconds * spec.rate_hz);
+  // The measurements, at the source rate where the stream is resampled.
+  const double measured_hz = spec.source_hz > 0.0 ? spec.source_hz : spec.rate_hz;
+  if (spec.source_hz > 0.0 && spec.resampling != "hold" && spec.resampling != "linear")
+    throw std::invalid_argument("no resampling '" + spec.resampling + "' (hold, linear)");
+  std::vector<Quat> measured;
+  for (std::size_t i = 0; static_cast<double>(i) / measured_hz <= spec.seconds + 1.0 / measured_hz; ++i) {
+    const double t = static_cast<double>(i) / measured_hz;
+    measured.push_back((truth_at(t) * so3::exp(random_offset(rng, spec.noise))).normalized());
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const double t = static_cast<double>(i) / spec.rate_hz;
     s.input.time.push_back(t);
-    s.input.orientation.push_back((truth_at(t) * so3::exp(random_offset(rng, spec.noise))).normalized());
+    if (spec.source_hz <= 0.0) {
+      s.input.orientation.push_back(measured[i]);
+      continue;
+    }
+    // The source sample at or before t (a hair's tolerance: t on a source time is that sample).
+    const double at = t * spec.source_hz;
+    const auto j = static_cast<std::size_t>(std::floor(at + 1e-9));
+    const double f = std::max(0.0, at - static_cast<double>(j));
+    s.input.orientation.push_back(spec.resampling == "hold" || f == 0.0 ? measured[j] : measured[j].slerp(f, measured[j + 1]).normalized());
   }
   std::vector<double> time;
   std::vector<Quat> orientation;

@@ -11,6 +11,10 @@
 // Noise as the quality benchmark's synthetic sets: exp(δ), ‖δ‖ uniform below the bound (dist on
 // S³). Deterministic: the seed is the stream's name. The truth is sampled 8 times as densely
 // (at least 2 kHz), so it can be looked up between samples.
+// Resampled: measured at a lower source rate and delivered at the stream's rate, as a tracker
+// polled faster than it updates ("hold": the newest measurement again) or a log put on another
+// clock ("linear": slerp between the two measurements around each time; BROAD's optical stream
+// is a 240 Hz one put on its IMU's 285.7 Hz clock so).
 #include <string>
 #include <vector>
 
@@ -23,15 +27,18 @@ struct GeneratedStreamSpec {
   double rate_hz = 100.0;
   double noise = 0.01;  // bound on ‖δ‖ (rad)
   double seconds = 20.0;
-  std::string name() const;  // "sway-100Hz-noise0.01"
+  double source_hz = 0.0;   // resampled from this rate (0: measured at rate_hz)
+  std::string resampling;   // hold, linear (with source_hz)
+  std::string name() const;  // "sway-100Hz-noise0.01", "sway-250Hz-noise0.01-from60Hz-hold"
 };
 
-// Every motion × rate (10, 30, 60, 120, 250, 1000 Hz) × noise (0.002, 0.01, 0.04); quick: sway
-// and turns at 30 and 100 Hz, noise 0.01, 5 s.
+// Every motion × rate (10, 30, 60, 120, 250, 1000 Hz) × noise (0.002, 0.01, 0.04), and still,
+// sway, turns and walk measured at 60 Hz under noise 0.01, resampled to 250 Hz both ways; quick:
+// sway and turns at 30 and 100 Hz, noise 0.01, 5 s.
 std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick);
 
 // The stream, its truth, and its first second (warm-up) left out of scoring. Throws
-// std::invalid_argument for a motion it does not know.
+// std::invalid_argument for a motion or resampling it does not know.
 QualitySequence generated_stream(const GeneratedStreamSpec& spec);
 
 }  // namespace posefair::tools

@@ -1,0 +1,58 @@
+// tools/generated_streams.cpp: the streams of `posefair bench streams`, here the resampled ones
+// (a tracker polled faster than it updates, a log put on another clock).
+#include <cmath>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "generated_streams.hpp"
+#include "posefair/core/so3.hpp"
+
+namespace posefair::tools {
+namespace {
+
+// Samples whose increment to the next equals the next one's (the same rotation twice running,
+// to rounding): a slerp at equal steps between two measurements.
+int equal_increments(const QualitySequence& s) {
+  int n = 0;
+  for (std::size_t i = 0; i + 2 < s.input.size(); ++i) {
+    const Vec3 a = so3::log(s.input.orientation[i].conjugate() * s.input.orientation[i + 1]);
+    const Vec3 b = so3::log(s.input.orientation[i + 1].conjugate() * s.input.orientation[i + 2]);
+    n += (a - b).norm() < 1e-9 * (1.0 + a.norm());
+  }
+  return n;
+}
+
+int changes(const QualitySequence& s) {
+  int n = 0;
+  for (std::size_t i = 0; i + 1 < s.input.size(); ++i) n += !s.input.orientation[i].coeffs().isApprox(s.input.orientation[i + 1].coeffs(), 0.0);
+  return n;
+}
+
+TEST(GeneratedStreams, AHeldStreamChangesOnlyAtTheSourceRate) {
+  const QualitySequence s = generated_stream({"sway", 250.0, 0.01, 20.0, 60.0, "hold"});
+  EXPECT_EQ(s.name, "sway-250Hz-noise0.01-from60Hz-hold");
+  ASSERT_EQ(s.input.size(), 5000u);
+  EXPECT_DOUBLE_EQ(s.input.time[1], 1.0 / 250.0);
+  // 20 s at 60 Hz: 1200 measurements, each new one once.
+  EXPECT_NEAR(changes(s), 1199, 1);
+}
+
+TEST(GeneratedStreams, ALinearStreamSlerpsBetweenTheSourceMeasurements) {
+  const QualitySequence linear = generated_stream({"walk", 250.0, 0.01, 20.0, 60.0, "linear"});
+  const QualitySequence native = generated_stream({"walk", 250.0, 0.01, 20.0, 0.0, {}});
+  // Between two measurements 1/60 s apart the stream takes equal steps. Every 0.1 s (25 samples,
+  // 6 measurements) a measurement falls on a sample and breaks the one pair of increments around
+  // it, and 5 fall between samples and break the two pairs that span each: 14 of every 25 of the
+  // 4998 pairs are equal.
+  EXPECT_NEAR(equal_increments(linear), 4998 * 14 / 25, 2);
+  EXPECT_EQ(equal_increments(native), 0);
+  EXPECT_EQ(changes(linear), 4999);
+}
+
+TEST(GeneratedStreams, AnUnknownResamplingIsAnError) {
+  EXPECT_THROW(generated_stream({"still", 250.0, 0.01, 5.0, 60.0, "cubic"}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace posefair::tools
