@@ -364,6 +364,29 @@ Vec3 apply_rows(const EmissionRow& a, const EmissionRow& b, double f, int n, std
 
 }  // namespace
 
+// What the level in use corrected at the emitted sample k, for the motion estimate
+// (MotionNoiseEstimator::note_correction): not where nothing was corrected (level 0, a window
+// still filling), where the correction is more than smoothing (a horizon extrapolates), at rest
+// (the rest line emits), on a gyro-aided rotation (its own estimator), or for an outlier held.
+// Between two levels the bias blends linearly and the gain is taken as blended too (it is
+// convex in f, so this is an upper bound: the test errs toward smoothing).
+void FairingWindow::note_correction(Channel& ch, int k, const Vec3& u, double dt) {
+  if (!ch.adaptive || !prepared_ || (&ch == &rot_ && aided_)) return;
+  const int i = static_cast<int>(ch.level);
+  const double f = ch.level - i;
+  const char bit = &ch == &rot_ ? kHeldRotation : kHeldPosition;
+  const bool learn = n_ == w_ && config_.horizon_s == 0.0 && !ch.estimator.at_rest() && (i > 0 || f > 0.0) &&
+                     !((held_[static_cast<std::size_t>(k)] | newest_held_) & bit);
+  if (!learn) {
+    ch.estimator.note_correction(0.0, 0.0, 0.0, dt);
+    return;
+  }
+  const EmissionRow& a = levels_[static_cast<std::size_t>(i)];
+  const EmissionRow& b = i + 1 < level_count_ ? levels_[static_cast<std::size_t>(i + 1)] : a;
+  ch.estimator.note_correction(u.squaredNorm() / 3.0, (1.0 - f) * a.correction_gain + f * b.correction_gain,
+                               (1.0 - f) * a.bias + f * b.bias, dt);
+}
+
 Vec3 FairingWindow::linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c) {
   if (!prepared_) return Vec3::Zero();  // the rate is not known yet: the measurement passes
   const int emitted = n_ - 1 - config_.lag;
@@ -441,11 +464,17 @@ void FairingWindow::linear_emission_estimate(int k, double dt) {
   if (k < 0) return;
   const auto i = static_cast<std::size_t>(k);
   // A motion leaving rest goes out as measured (k is the newest sample, and there is no horizon).
-  est_[i] = rot_departs == Departure::Moving ? Vec3::Zero()
-                                              : rest_blend(rot_, k, linear_correction(rot_, rotation_increments(), c_), dt);
-  if (positions_)
-    xp_[i] = zp_[i] + (pos_departs == Departure::Moving ? Vec3::Zero()
-                                                        : rest_blend(pos_, k, linear_correction(pos_, dzp_, cp_), dt));
+  auto correction = [&](Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c, Departure departs) -> Vec3 {
+    if (departs == Departure::Moving) {
+      note_correction(ch, k, Vec3::Zero(), dt);
+      return Vec3::Zero();
+    }
+    const Vec3 u = linear_correction(ch, zeta, c);
+    note_correction(ch, k, u, dt);
+    return rest_blend(ch, k, u, dt);
+  };
+  est_[i] = correction(rot_, rotation_increments(), c_, rot_departs);
+  if (positions_) xp_[i] = zp_[i] + correction(pos_, dzp_, cp_, pos_departs);
 }
 
 // At rest, the rotation's count newest increments on the rest line's chart, for the rest test's

@@ -69,6 +69,7 @@ bool EmissionRowBuilder::build(int n, double mu, const EmissionTarget& t, Emissi
   std::fill(row.c.begin(), row.c.end(), 0.0);
   row.noise_gain = 1.0;
   row.bias = 0.0;
+  row.correction_gain = 0.0;
   if (k < 0) return true;
   for (int i = 0; i < n; ++i) diag_[static_cast<std::size_t>(i)] = 1.0 + (i < emitted ? t.continuity : 0.0);
   if (!assemble_smoothing_system(system_, n, m, mu, std::span(diag_).first(static_cast<std::size_t>(n)))) return false;
@@ -102,6 +103,7 @@ bool EmissionRowBuilder::build(int n, double mu, const EmissionTarget& t, Emissi
   }
   row.noise_gain = shared_noise_gain(row, row, n, k);
   row.bias = response - std::pow(target - k, m) / mf;
+  row.correction_gain = row.noise_gain - 2.0 * theta_weight(row, n, k, k) + 1.0;
   // Rows decay geometrically into the past: skip what cannot change a double's worth.
   const double negligible = 1e-12 * largest;
   int first = 0;

@@ -97,6 +97,7 @@ MotionNoiseEstimator::MotionNoiseEstimator(int capacity, int order)
 
 void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& settings, int window) {
   settings_ = settings;
+  decay_dt_ = 0.0;  // motion_time_s may have changed
   const int m = order_;
   // The span is motion_span_s at the stream's rate, but never fewer than the m + 1 samples that
   // determine a degree-m polynomial (then the fit is the plain m-th difference). At a low rate
@@ -311,13 +312,31 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
                          std::max(e_.peak, e_.peak_before) >= kRestOnsetFactor * fit_noise;
       e_.motion_var = e_.mean_square < threshold * fit_noise || !clear ? 0.0 : e_.mean_square - fit_noise;
     } else {
-      e_.motion_var = std::max(motion_floor(fit_noise), e_.mean_square - fit_noise);
+      e_.motion_var = std::max({motion_floor(fit_noise), e_.mean_square - fit_noise, e_.bias_motion});
     }
     // The fast part counts where it stands clear of the noise its fit lets through.
     if (short_span_ > 0 && e_.short_mean_square > kFastMotionFactor * short_noise)
       e_.motion_var = std::max(e_.motion_var, e_.short_mean_square - short_noise);
   }
   return refreshed || ready() != was_ready;
+}
+
+void MotionNoiseEstimator::note_correction(double mean_square, double correction_gain, double bias, double dt) {
+  if (e_.bias_motion > 0.0 && dt > 0.0) {
+    if (dt != decay_dt_) {  // the stream's step, nearly always the last one's
+      decay_dt_ = dt;
+      decay_ = std::exp(-dt / settings_.motion_time_s);
+    }
+    e_.bias_motion *= decay_;
+    // Gone where it can no longer count (and before it decays into subnormal numbers).
+    if (e_.bias_motion < 1e-6 * e_.noise_var * fit_noise_gain_) e_.bias_motion = 0.0;
+  }
+  // Twice running, and the smaller of the two: a glitch the outlier guard let through is one
+  // large correction (its neighbours' are a fraction of it), a drag after a turn lasts.
+  const double noise = e_.noise_var * correction_gain;
+  const double implied = bias != 0.0 && mean_square > kBiasFactor * noise ? (mean_square - noise) / (bias * bias) : 0.0;
+  if (implied > 0.0 && e_.bias_last > 0.0) e_.bias_motion = std::max(e_.bias_motion, std::min(implied, e_.bias_last));
+  e_.bias_last = implied;
 }
 
 double best_level(std::span<const EmissionRow> rows, std::span<const double> shared_gain, int count, double noise_var,

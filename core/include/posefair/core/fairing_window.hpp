@@ -217,6 +217,7 @@ class FairingWindow {
   Departure departs_from_rest(Channel& ch);
   Vec3 rest_coordinate(const Channel& ch, int j) const;
   char newest_held_ = 0;  // the channels whose newest sample the guard held (kHeld*; at lag 0 emitted as measured all the same)
+  void note_correction(Channel& ch, int k, const Vec3& u, double dt);
   Vec3 linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c);
   void follow_rest(Channel& ch, bool departs);
   Vec3 rest_blend(Channel& ch, int k, const Vec3& window, double dt);

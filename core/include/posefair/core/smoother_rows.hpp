@@ -40,6 +40,7 @@ struct EmissionRow {
   int first = 0;             // zeta[j] and c[j] are negligible below this index
   double noise_gain = 0.0;   // Σ s_i², s the weights on θ
   double bias = 0.0;         // error per unit m-th difference of the truth
+  double correction_gain = 0.0;  // Σ (s_i − δ_ik)²: the noise in the correction (output − measurement)
 };
 
 class EmissionRowBuilder {

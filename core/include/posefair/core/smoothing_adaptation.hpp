@@ -134,6 +134,17 @@ class MotionNoiseEstimator {
   // noise twice running, about 1 in 25 after a turn had stopped) and took half the gain on the
   // rests set (1.3% instead of 2.3%); at 3 a shake and a walk at 250 Hz and 1 kHz lost 1–2%.
   static constexpr double kMotionStopFactor = 2.0;
+  // A smoothing level's correction (output − measurement) that stands this many times over what
+  // the noise alone puts in it (its mean square against σ² times the level's correction gain) is
+  // bias: motion the estimate missed. The m-th difference that bias implies through the level's
+  // bias per unit counts as motion, kept for motion_time_s. After a turn stops, the stop rule
+  // drops the motion to the noise while the turn is still in the window, and a heavy level then
+  // drags the pose after the turn: on a clean stream (noise 0.0001 rad) 0.003–0.006 rad off, six
+  // times raw's error. So high because the implied difference holds for the level that made the
+  // correction and overstates it for lighter ones, whose rows do not reach back to the turn: at
+  // 32 quick turns under noise 0.01 at 30 Hz lost 0.9%, at 128 nothing did (docs/engine.md,
+  // "A correction the noise does not explain").
+  static constexpr double kBiasFactor = 128.0;
   // Moving, a fit whose excess over its noise is this many times the motion's (or the noise's,
   // if larger), twice running and growing, is a faster motion starting (a head turned quickly):
   // taken at once too. Averaged in, a 60° turn in 0.1–0.15 s was over before the average saw
@@ -187,6 +198,8 @@ class MotionNoiseEstimator {
     bool window_ready = false;
     double line_mean_square = 0.0;
     bool line_ready = false;
+    double bias_motion = 0.0;  // d² implied by corrections over kBiasFactor times their noise, decaying
+    double bias_last = 0.0;    // the last correction's implied d² (0: within that)
     bool at_rest = false;
     bool onset_over = false;  // the last fit stood over the onset threshold
     double onset_last = 0.0;  // the last fit's mean square
@@ -195,6 +208,10 @@ class MotionNoiseEstimator {
     // the time the newer half has run: the largest fit of the last half to whole span.
     double peak = 0.0, peak_before = 0.0, peak_s = 0.0;
   };
+  // What the level in use corrected at the emitted sample: the correction's mean square per
+  // component, the level's correction gain and bias per unit m-th difference (EmissionRow);
+  // mean_square 0 and bias 0 where nothing was corrected. The motion follows it (kBiasFactor).
+  void note_correction(double mean_square, double correction_gain, double bias, double dt);
   const Estimates& estimates() const { return e_; }
   void restore(const Estimates& e) { e_ = e; }
 
@@ -222,6 +239,7 @@ class MotionNoiseEstimator {
   std::vector<double> fit_;      // weights on the span's span−1 differences
   double fit_noise_gain_ = 0.0;  // Σ of the fit's squared weights on θ
   double peak_half_s_ = 0.0;     // half the fit's span (s): the blocks of Estimates::peak
+  double decay_dt_ = 0.0, decay_ = 1.0;  // Estimates::bias_motion's factor per step, for the last step
   // The motion's fast part: the same fit over half the span (0: none), and its noise gain.
   int short_span_ = 0;
   std::vector<double> short_fit_;
