@@ -109,7 +109,7 @@ std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick) {
   }
   for (const char* motion : {"still", "sway", "turns", "shake", "walk"})
     for (double rate : {10.0, 30.0, 60.0, 120.0, 250.0, 1000.0})
-      for (double noise : {0.002, 0.01, 0.04}) out.push_back({motion, rate, noise, rate > 500.0 ? 10.0 : 20.0, 0.0, {}});
+      for (double noise : {0.0002, 0.002, 0.01, 0.04}) out.push_back({motion, rate, noise, rate > 500.0 ? 10.0 : 20.0, 0.0, {}});
   for (const char* motion : {"still", "sway", "turns", "walk"})
     for (const char* resampling : {"hold", "linear"}) out.push_back({motion, 250.0, 0.01, 20.0, 60.0, resampling});
   return out;

@@ -32,7 +32,8 @@ struct GeneratedStreamSpec {
   std::string name() const;  // "sway-100Hz-noise0.01", "sway-250Hz-noise0.01-from60Hz-hold"
 };
 
-// Every motion × rate (10, 30, 60, 120, 250, 1000 Hz) × noise (0.002, 0.01, 0.04), and still,
+// Every motion × rate (10, 30, 60, 120, 250, 1000 Hz) × noise (0.0002: a clean stream, as a good
+// VR tracker's; 0.002, 0.01, 0.04), and still,
 // sway, turns and walk measured at 60 Hz under noise 0.01, resampled to 250 Hz both ways; quick:
 // sway and turns at 30 and 100 Hz, noise 0.01, 5 s.
 std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick);
