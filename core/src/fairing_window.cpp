@@ -214,7 +214,10 @@ FairingWindow::FairingWindow(const WindowConfig& config)
   const bool linear = config.solver == WindowSolver::Linear;
   rot_.adaptive = linear && smoothing_source(config, true) == SmoothingSource::Adaptive;
   pos_.adaptive = linear && smoothing_source(config, false) == SmoothingSource::Adaptive;
-  if (rot_.adaptive || pos_.adaptive) levels_.assign(kMaxSmoothingLevels, make_emission_row(capacity_));
+  if (rot_.adaptive || pos_.adaptive) {
+    levels_.assign(kMaxSmoothingLevels, make_emission_row(capacity_));
+    level_tail_bias_.assign(static_cast<std::size_t>(kMaxSmoothingLevels * capacity_), 0.0);
+  }
   if (!linear) {
     // The iterative solvers' settings are fixed at construction (validate() made sure they can be).
     rot_.mu = resolvable(config, true) ? fixed_smoothing(config, true, config.rate_hz) : 0.0;
@@ -310,6 +313,10 @@ void FairingWindow::prepare(double rate_hz) {
       for (int l = 0; l + 1 < level_count_; ++l)
         level_shared_gain_[static_cast<std::size_t>(l)] =
             shared_noise_gain(levels_[static_cast<std::size_t>(l)], levels_[static_cast<std::size_t>(l + 1)], w_, k);
+      for (int c = 0; c + 1 < w_; ++c)
+        for (int l = 0; l < level_count_; ++l)
+          level_tail_bias_[static_cast<std::size_t>(c * kMaxSmoothingLevels + l)] =
+              tail_bias(levels_[static_cast<std::size_t>(l)], w_, target_spec_, c);
       rot_.estimator.configure(rate_hz, config_.adaptation, w_);
       pos_.estimator.configure(rate_hz, config_.adaptation, w_);
       AdaptationSettings aided = config_.adaptation;
@@ -333,8 +340,16 @@ void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
     return;
   }
   if (!refreshed) return;  // the level follows the motion estimate's refreshes
+  // A motion that stopped and is still in the window: each level's drag towards it counts too.
+  const MotionNoiseEstimator::StoppedMotion stopped = estimator.stopped_motion(w_);
+  const std::span<const double> tail =
+      stopped.motion_var > 0.0
+          ? std::span<const double>(level_tail_bias_).subspan(static_cast<std::size_t>(stopped.clear * kMaxSmoothingLevels),
+                                                              static_cast<std::size_t>(level_count_))
+          : std::span<const double>{};
+  const double margin = config_.adaptation.motion_margin;
   ch.level = best_level(levels_, level_shared_gain_, level_count_, estimator.noise_variance(),
-                        config_.adaptation.motion_margin * estimator.motion_variance());
+                        margin * estimator.motion_variance(), tail, margin * stopped.motion_var);
   // The μ a window still filling uses, and the one reported: geometric between the levels
   // (linear from the pass-through level 0).
   const int i = static_cast<int>(ch.level);
@@ -628,7 +643,7 @@ std::size_t FairingWindow::memory_bytes() const {
             rhs_.capacity()) * sizeof(Vec3);
   bytes += (diag_.capacity() + sampled_step_.capacity() + stamp_.capacity()) * sizeof(double) + window_clamped_.capacity() + held_.capacity();
   auto row_bytes = [](const EmissionRow& r) { return (r.zeta.capacity() + r.c.capacity()) * sizeof(double); };
-  bytes += levels_.capacity() * sizeof(EmissionRow);
+  bytes += levels_.capacity() * sizeof(EmissionRow) + level_tail_bias_.capacity() * sizeof(double);
   for (const EmissionRow& r : levels_) bytes += row_bytes(r);
   bytes += row_bytes(fill_row_) + row_bytes(rot_.fixed) + row_bytes(pos_.fixed);
   // The builder's band matrix and scratch, and the three estimators' fit, half-span fit, window

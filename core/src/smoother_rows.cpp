@@ -59,6 +59,15 @@ double shared_noise_gain(const EmissionRow& a, const EmissionRow& b, int n, int 
   return sum;
 }
 
+double tail_bias(const EmissionRow& row, int n, const EmissionTarget& target, int clear) {
+  const int m = target.order, k = n - 1 - target.lag, s = n - 1 - clear;
+  const double mf = factorial(m);
+  auto truth = [&](double i) { return i < s ? std::pow(s - i, m) / mf : 0.0; };
+  double response = 0.0;
+  for (int i = 0; i < s; ++i) response += theta_weight(row, n, k, i) * truth(i);
+  return response - truth(k + std::max(0.0, target.horizon));
+}
+
 bool EmissionRowBuilder::build(int n, double mu, const EmissionTarget& t, EmissionRow& row) {
   const int m = order_;
   const int k = n - 1 - t.lag;

@@ -192,6 +192,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
   // The rest test's line is taken on a full window only: after a restart its average starts afresh.
   if (n1 < line_span_ - 1) e_.line_ready = e_.window_ready = false;
   bool refreshed = false;
+  if (e_.stopped_motion > 0.0 && ++e_.samples_since_stop >= capacity_) e_.stopped_motion = 0.0;
   if (n1 >= low_.order) {
     update_median(e_.low, newest_difference(zeta, low_).norm(), dt);
     double s = std::exp(e_.low.log_median) * low_.sigma_per_median;
@@ -240,6 +241,8 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
         const bool stopped = e_.mean_square > kRestOnsetFactor * fit_noise && sample < kMotionStopFactor * fit_noise &&
                              std::max(h0, h1) < kMotionStopFactor * short_noise;
         if (stopped && e_.stop_last) {
+          e_.stopped_motion = std::max(0.0, e_.mean_square - fit_noise);
+          e_.samples_since_stop = 0;
           e_.mean_square = fit_noise;
           e_.short_mean_square = std::min(e_.short_mean_square, short_noise);
         }
@@ -321,6 +324,12 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
   return refreshed || ready() != was_ready;
 }
 
+MotionNoiseEstimator::StoppedMotion MotionNoiseEstimator::stopped_motion(int window) const {
+  const int clear = span_ - 1 + e_.samples_since_stop;
+  if (e_.at_rest || e_.stopped_motion <= 0.0 || clear >= window - 1) return {};
+  return {e_.stopped_motion, clear};
+}
+
 void MotionNoiseEstimator::note_correction(double mean_square, double correction_gain, double bias, double dt) {
   if (e_.bias_motion > 0.0 && dt > 0.0) {
     if (dt != decay_dt_) {  // the stream's step, nearly always the last one's
@@ -340,11 +349,14 @@ void MotionNoiseEstimator::note_correction(double mean_square, double correction
 }
 
 double best_level(std::span<const EmissionRow> rows, std::span<const double> shared_gain, int count, double noise_var,
-                  double motion_var) {
+                  double motion_var, std::span<const double> tail, double tail_var) {
   if (count <= 1) return 0.0;
+  if (tail.empty()) tail_var = 0.0;
+  auto tail_of = [&](int l) { return tail_var > 0.0 ? tail[static_cast<std::size_t>(l)] : 0.0; };
   auto cost = [&](int l) {
     const EmissionRow& r = rows[static_cast<std::size_t>(l)];
-    return noise_var * r.noise_gain + motion_var * r.bias * r.bias;
+    const double t = tail_of(l);
+    return noise_var * r.noise_gain + motion_var * r.bias * r.bias + tail_var * t * t;
   };
   int best = 0;
   double best_cost = cost(0);
@@ -362,16 +374,16 @@ double best_level(std::span<const EmissionRow> rows, std::span<const double> sha
   if (best == 0) return 0.0;
   // The blend between levels l and l + 1: its expected error is a quadratic in f with
   // c2 = σ²(G_l − 2G_{l,l+1} + G_{l+1}) + d²(B_{l+1} − B_l)² ≥ 0 (the variance of the rows'
-  // difference) and c1 = −2σ²(G_l − G_{l,l+1}) + 2d²B_l(B_{l+1} − B_l).
+  // difference) and c1 = −2σ²(G_l − G_{l,l+1}) + 2d²B_l(B_{l+1} − B_l); the tail's e²T as the bias.
   double level = best;
   auto refine = [&](int l) {
     if (l < 0 || l + 1 >= count) return;
     const EmissionRow& a = rows[static_cast<std::size_t>(l)];
     const EmissionRow& b = rows[static_cast<std::size_t>(l + 1)];
     const double g = shared_gain[static_cast<std::size_t>(l)];
-    const double db = b.bias - a.bias;
-    const double c2 = noise_var * (a.noise_gain - 2.0 * g + b.noise_gain) + motion_var * db * db;
-    const double c1 = -2.0 * noise_var * (a.noise_gain - g) + 2.0 * motion_var * a.bias * db;
+    const double db = b.bias - a.bias, dt = tail_of(l + 1) - tail_of(l);
+    const double c2 = noise_var * (a.noise_gain - 2.0 * g + b.noise_gain) + motion_var * db * db + tail_var * dt * dt;
+    const double c1 = -2.0 * noise_var * (a.noise_gain - g) + 2.0 * motion_var * a.bias * db + 2.0 * tail_var * tail_of(l) * dt;
     if (!(c2 > 0.0)) return;
     const double f = std::clamp(-0.5 * c1 / c2, 0.0, 1.0);
     const double c = cost(l) + c1 * f + c2 * f * f;

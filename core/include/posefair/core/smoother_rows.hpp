@@ -78,4 +78,11 @@ EmissionRow make_emission_row(int capacity);
 // their outputs is σ² times this (a row with itself: its noise_gain).
 double shared_noise_gain(const EmissionRow& a, const EmissionRow& b, int n, int k);
 
+// The row's error per unit m-th difference of a motion that stopped `clear` samples before the
+// newest (0 ≤ clear < n − 1): a truth that is a degree-m polynomial up to sample s = n − 1 − clear,
+// d·(s − i)^m/m!, and still after it, meeting the still pose there with all its derivatives.
+// The row's `bias` is the same for a motion that has not stopped; a heavy row reaches further
+// back than `clear` and drags the still pose towards the motion before it.
+double tail_bias(const EmissionRow& row, int n, const EmissionTarget& target, int clear);
+
 }  // namespace posefair

@@ -204,6 +204,10 @@ class MotionNoiseEstimator {
     bool onset_over = false;  // the last fit stood over the onset threshold
     double onset_last = 0.0;  // the last fit's mean square
     bool stop_last = false;   // the last fit stood within its noise after a clear motion
+    // The motion the stop rule dropped (d², 0: none) and the samples taken since: it is still in
+    // the window's older samples until the window has slid past it.
+    double stopped_motion = 0.0;
+    int samples_since_stop = 0;
     // The largest fit of the last half span and of the half span before it (in stream time), and
     // the time the newer half has run: the largest fit of the last half to whole span.
     double peak = 0.0, peak_before = 0.0, peak_s = 0.0;
@@ -216,6 +220,16 @@ class MotionNoiseEstimator {
   void restore(const Estimates& e) { e_ = e; }
 
   bool ready() const { return e_.low.count > 0 && e_.motion_ready; }
+  // A motion that stopped while still in the window: its d² (per component, per sample^(2m)) and
+  // how many of the newest samples are clear of it (the fit's span, within its noise when the
+  // stop rule fired, and the samples since). None (motion_var 0) at rest, or once `window`
+  // samples are clear. The level chosen weighs the drag each row puts on the still pose
+  // (tail_bias in smoother_rows.hpp).
+  struct StoppedMotion {
+    double motion_var = 0.0;
+    int clear = 0;
+  };
+  StoppedMotion stopped_motion(int window) const;
   bool at_rest() const { return e_.at_rest; }
   double noise_variance() const { return e_.noise_var; }    // σ², per component, per sample
   double motion_variance() const { return e_.motion_var; }  // d², per component, per sample^(2m)
@@ -257,11 +271,13 @@ class MotionNoiseEstimator {
 };
 
 // The smoothing level (a real index into rows, ordered from least to most smoothing) with the
-// smallest expected squared error σ²·G + d²·B². A fractional level l + f emits the blend
+// smallest expected squared error σ²·G + d²·B² (+ e²·T², below). A fractional level l + f emits the blend
 // (1 − f)·u_l + f·u_{l+1}, whose bias (1 − f)B_l + f·B_{l+1} and noise gain
 // (1 − f)²G_l + 2f(1 − f)G_{l,l+1} + f²G_{l+1} are exact, so f is chosen exactly on both sides
 // of the best whole level. shared_gain[l] = G_{l,l+1} (shared_noise_gain of rows l and l + 1).
+// tail[l], where given: row l's tail_bias for a motion that stopped (MotionNoiseEstimator::
+// stopped_motion), whose d² is tail_var; its drag e²·T² adds to the error as the bias does.
 double best_level(std::span<const EmissionRow> rows, std::span<const double> shared_gain, int count, double noise_var,
-                  double motion_var);
+                  double motion_var, std::span<const double> tail = {}, double tail_var = 0.0);
 
 }  // namespace posefair
