@@ -379,6 +379,18 @@ Vec3 apply_rows(const EmissionRow& a, const EmissionRow& b, double f, int n, std
 
 }  // namespace
 
+// The level in use's two rows and the blend between them (f: the second's share).
+FairingWindow::LevelRows FairingWindow::level_rows(const Channel& ch) const {
+  const int i = static_cast<int>(ch.level);
+  const EmissionRow& a = levels_[static_cast<std::size_t>(i)];
+  return {a, i + 1 < level_count_ ? levels_[static_cast<std::size_t>(i + 1)] : a, ch.level - i};
+}
+
+double FairingWindow::correction_gain(const Channel& ch) const {
+  const LevelRows r = level_rows(ch);
+  return (1.0 - r.f) * r.a.correction_gain + r.f * r.b.correction_gain;
+}
+
 // What the level in use corrected at the emitted sample k, for the motion estimate
 // (MotionNoiseEstimator::note_correction): not where nothing was corrected (level 0, a window
 // still filling), where the correction is more than smoothing (a horizon extrapolates), at rest
@@ -387,19 +399,15 @@ Vec3 apply_rows(const EmissionRow& a, const EmissionRow& b, double f, int n, std
 // convex in f, so this is an upper bound: the test errs toward smoothing).
 void FairingWindow::note_correction(Channel& ch, int k, const Vec3& u, double dt) {
   if (!ch.adaptive || !prepared_ || (&ch == &rot_ && aided_)) return;
-  const int i = static_cast<int>(ch.level);
-  const double f = ch.level - i;
   const char bit = &ch == &rot_ ? kHeldRotation : kHeldPosition;
-  const bool learn = n_ == w_ && config_.horizon_s == 0.0 && !ch.estimator.at_rest() && (i > 0 || f > 0.0) &&
+  const bool learn = n_ == w_ && config_.horizon_s == 0.0 && !ch.estimator.at_rest() && ch.level > 0.0 &&
                      !((held_[static_cast<std::size_t>(k)] | newest_held_) & bit);
   if (!learn) {
     ch.estimator.note_correction(0.0, 0.0, 0.0, dt);
     return;
   }
-  const EmissionRow& a = levels_[static_cast<std::size_t>(i)];
-  const EmissionRow& b = i + 1 < level_count_ ? levels_[static_cast<std::size_t>(i + 1)] : a;
-  ch.estimator.note_correction(u.squaredNorm() / 3.0, (1.0 - f) * a.correction_gain + f * b.correction_gain,
-                               (1.0 - f) * a.bias + f * b.bias, dt);
+  const LevelRows r = level_rows(ch);
+  ch.estimator.note_correction(u.squaredNorm() / 3.0, correction_gain(ch), (1.0 - r.f) * r.a.bias + r.f * r.b.bias, dt);
 }
 
 Vec3 FairingWindow::linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c) {
@@ -481,11 +489,25 @@ void FairingWindow::linear_emission_estimate(int k, double dt) {
   // A motion leaving rest goes out as measured (k is the newest sample, and there is no horizon).
   auto correction = [&](Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c, Departure departs) -> Vec3 {
     if (departs == Departure::Moving) {
+      ch.rest.leaving = ch.estimator.span();
       note_correction(ch, k, Vec3::Zero(), dt);
       return Vec3::Zero();
     }
     const Vec3 u = linear_correction(ch, zeta, c);
     note_correction(ch, k, u, dt);
+    // The motion estimate takes a motion out of rest from its fits, which see its start dimly for
+    // a few samples more (at most the fit's span); meanwhile the level chosen lags it. Where the
+    // level's correction stands off the measurement by more than the noise could put it (as a
+    // departure from the line does), the sample still goes out as measured, and the correction
+    // it would have made is noted all the same (kBiasFactor: it is motion the estimate missed).
+    // The first within the noise ends that.
+    if (ch.rest.leaving > 0) {
+      --ch.rest.leaving;
+      if (departs == Departure::None && n_ == w_ &&
+          u.squaredNorm() / 3.0 > kRestDepartureFactor * ch.estimator.noise_variance() * correction_gain(ch))
+        return Vec3::Zero();
+      ch.rest.leaving = 0;
+    }
     return rest_blend(ch, k, u, dt);
   };
   est_[i] = correction(rot_, rotation_increments(), c_, rot_departs);

@@ -1305,10 +1305,13 @@ TEST(Adaptation, ACleanStreamIsNotDraggedAfterATurn) {
   // the turn, by 50 times the noise. The corrections it makes say so (kBiasFactor): 3.7 and 1.3
   // times raw's error at 100 and 250 Hz, against 6.7 and 7.9 without. The level is also chosen
   // knowing the stopped turn is in the window (MotionNoiseEstimator::stopped_motion): 0.79, 2.05
-  // and 1.27 times raw's error at 30, 100 and 250 Hz, against 4.5, 3.7 and 1.3 without. What is
-  // left is mostly the turns' first samples (docs/engine.md, "A correction the noise does not
-  // explain", "A motion that stopped is still in the window").
-  for (const auto& [rate, bound] : {std::pair{30.0, 2.0}, std::pair{100.0, 3.0}, std::pair{250.0, 2.0}}) {
+  // and 1.27 times raw's error at 30, 100 and 250 Hz, against 4.5, 3.7 and 1.3 without. And a
+  // turn out of rest goes on out as measured while the level's correction stands over the noise
+  // (FairingWindow's Rest::leaving): 1.17 and 1.05 at 200 and 250 Hz, against 1.33 and 1.27
+  // without. What is left is mostly the turns' first samples (docs/engine.md, "A correction the
+  // noise does not explain", "A motion that stopped is still in the window", "At rest").
+  for (const auto& [rate, bound] :
+       {std::pair{30.0, 2.0}, std::pair{100.0, 3.0}, std::pair{200.0, 1.25}, std::pair{250.0, 1.15}}) {
     SCOPED_TRACE(std::to_string(rate) + " Hz");
     double raw = 0.0, smoothed = 0.0;
     for (std::uint64_t seed = 1; seed <= 3; ++seed) {

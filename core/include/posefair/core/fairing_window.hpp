@@ -184,6 +184,9 @@ class FairingWindow {
       double weight = 0.0;
       bool averaged = false;
       Vec3 departure = Vec3::Zero();  // how far the newest sample left the line (zero: it did not)
+      // After a motion left rest (emitted as measured): the samples for which the next ones still
+      // go out as measured while the level's correction stands over the noise (linear_emission_estimate).
+      int leaving = 0;
     } rest;
   };
   // What a channel's adaptation had learnt before a held sample went in: put back when the next
@@ -218,6 +221,13 @@ class FairingWindow {
   Vec3 rest_coordinate(const Channel& ch, int j) const;
   char newest_held_ = 0;  // the channels whose newest sample the guard held (kHeld*; at lag 0 emitted as measured all the same)
   void note_correction(Channel& ch, int k, const Vec3& u, double dt);
+  struct LevelRows {
+    const EmissionRow& a;
+    const EmissionRow& b;
+    double f;
+  };
+  LevelRows level_rows(const Channel& ch) const;
+  double correction_gain(const Channel& ch) const;  // of the level in use
   Vec3 linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c);
   void follow_rest(Channel& ch, bool departs);
   Vec3 rest_blend(Channel& ch, int k, const Vec3& window, double dt);
