@@ -1178,6 +1178,53 @@ TEST(EmissionRows, TheirBiasAndNoiseGainPredictTheEngine) {
   }
 }
 
+TEST(EmissionRows, TheirTailBiasIsTheErrorOnAMotionThatStopped) {
+  // A motion that stopped: positions a·(S − i)²/2 up to sample S, then still. c samples after the
+  // stop the engine's output is a·tail_bias(c) off the still pose, and nothing once the window has
+  // slid past the stop. The pass-through row has none; a heavy row's starts at its bias and fades
+  // (MotionNoiseEstimator::stopped_motion, docs/engine.md).
+  const int w = 40, stop = 300;
+  const double a = 0.02;
+  for (int lag : {0, 3}) {
+    WindowConfig c;
+    c.window = w;
+    c.lag = lag;
+    c.smoothing_r = c.smoothing_t = 300.0;
+    const EmissionTarget target{2, lag, 0.0, 0.0};
+    EmissionRowBuilder builder(w, 2);
+    EmissionRow row = make_emission_row(w), pass = make_emission_row(w);
+    ASSERT_TRUE(builder.build(w, 300.0, target, row));
+    ASSERT_TRUE(builder.build(w, 0.0, target, pass));
+    FairingWindow engine(c);
+    std::vector<FairedPose> out(static_cast<std::size_t>(engine.max_outputs_per_push()));
+    auto truth = [&](int i) { return i < stop ? 0.5 * a * (stop - i) * (stop - i) : 0.0; };
+    int checked = 0;
+    for (int i = 0; i < stop + 2 * w; ++i) {
+      Sample s;
+      s.sequence = static_cast<std::uint64_t>(i);
+      s.time = 0.01 * i;
+      s.flags = kHasPosition;
+      s.position = Vec3(truth(i), 0.0, 0.0);
+      const int k = engine.push(s, out);
+      ASSERT_EQ(k, i >= lag ? 1 : 0);
+      if (k == 0 || i < stop) continue;
+      const int clear = i - stop;  // newest samples since the stop
+      const double error = out[0].position.x() - truth(i - lag);
+      if (clear < w - 1) {
+        EXPECT_NEAR(error, a * tail_bias(row, w, target, clear), 1e-7) << "lag " << lag << " clear " << clear;
+        EXPECT_NEAR(tail_bias(pass, w, target, clear), 0.0, 1e-12) << "lag " << lag << " clear " << clear;
+        ++checked;
+      } else {
+        EXPECT_NEAR(error, 0.0, 1e-7) << "lag " << lag << " clear " << clear;
+      }
+    }
+    EXPECT_EQ(checked, w - 1);
+    // Just stopped, the window holds the polynomial whole: the row's bias. Nearly slid past, nothing.
+    EXPECT_NEAR(tail_bias(row, w, target, 0), row.bias, 1e-9 * std::abs(row.bias)) << "lag " << lag;
+    EXPECT_LT(std::abs(tail_bias(row, w, target, w - 2)), 1e-3 * std::abs(row.bias)) << "lag " << lag;
+  }
+}
+
 TEST(Prediction, ConstantMotionIsPredictedExactlyAndStampedWithItsTime) {
   // About one axis rotations commute, so the linearised extrapolation is exact: m = 2 for a
   // constant angular velocity, m = 3 for a constant angular acceleration.
