@@ -119,6 +119,11 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
                 static_cast<unsigned long long>(r.counters.emitted), static_cast<unsigned long long>(r.counters.clamped),
                 static_cast<unsigned long long>(r.counters.restarts), static_cast<unsigned long long>(r.counters.rate_changes),
                 static_cast<unsigned long long>(r.gate.dropped()), static_cast<unsigned long long>(r.gate.rejected()));
+    if (r.counters.repeated > 0)
+      std::printf("repeats  %llu samples repeated the measurement before them (a source read faster than it updates), "
+                  "carried forward from the poses before; %s\n",
+                  static_cast<unsigned long long>(r.counters.repeated),
+                  st.repeating ? "the window holds the measurements alone, at the source's rate" : "not repeating at the end");
     const double threshold = outlier_threshold(c);
     if (threshold > 0.0)
       std::printf("outliers %llu held at the prediction (threshold %g%s), %llu of them released as a motion's start\n",

@@ -454,6 +454,7 @@ EngineState FairingWindow::state() const {
   EngineState s;
   s.rate_hz = rate_;
   s.window = w_;
+  s.repeating = repeating_;
   const double dt = rate_ > 0.0 ? 1.0 / rate_ : 0.0;
   s.gyro = gyro_.state(aided_);
   for (const bool rotation : {true, false}) {
@@ -727,11 +728,108 @@ int FairingWindow::emit_pending(std::span<FairedPose> out) {
 
 int FairingWindow::flush(std::span<FairedPose> out) { return emit_pending(out); }
 
+// Repeats are carried forward at lag 0 only (with a lag the poses are the window's L samples
+// back, and a repeat has no place among them), and where the rate is measured (a rate given is
+// the one the window keeps).
+bool FairingWindow::carries_repeats() const { return config_.lag == 0 && rate_measured_ && !aided_; }
+
+// The stream started or stopped repeating its measurements (repeated_measurements.hpp): to the
+// window it is another stream, at another rate and with another noise per sample, so it starts
+// as a new stream does: its rate measured again, and nothing the adaptation learnt kept.
+int FairingWindow::start_afresh(std::span<FairedPose> out) {
+  const int count = n_ > 0 ? emit_pending(out) : 0;
+  ++counters_.restarts;
+  // The next pose's step is still from the last one (the gate forgets it below).
+  afresh_from_ = carried_time_ >= 0.0 ? carried_time_ : (window_poses_.count > 0 ? window_poses_.time[1] : -1.0);
+  window_poses_.count = 0;
+  carried_time_ = -1.0;
+  gate_.restart();
+  gate_.set_interval(0.0);
+  have_time_ = false;
+  rate_ = 0.0;
+  prepared_ = false;
+  rate_estimate_ = StreamRateEstimate();
+  rate_check_ = StreamRateEstimate(kMaxRateIntervals);
+  rate_candidate_ = 0.0;
+  for (Channel* ch : {&rot_, &pos_}) {
+    ch->estimator.restore({});
+    ch->rest = Channel::Rest{};
+    ch->mu = 0.0;
+    ch->level = 0.0;
+  }
+  rot_guard_ = OutlierGuard(outlier_threshold(config_), 0.5);
+  pos_guard_ = OutlierGuard(outlier_threshold(config_), 1.0);
+  return count;
+}
+
+// The motion of the window's last two poses, carried on to the repeat's time, for at most one
+// interval of the source (a repeat later than that is a source that stalled: held, not
+// extrapolated). Bounded by ε around the measurement, as every pose.
+FairedPose FairingWindow::carry_forward(const Sample& s) {
+  ++counters_.repeated;
+  const WindowPoses& w = window_poses_;
+  Quat q = w.orientation[1];
+  Vec3 p = w.position[1];
+  if (w.count >= 2 && w.time[1] > w.time[0]) {
+    const double ahead = std::min(s.time - w.time[1], typical_interval()) / (w.time[1] - w.time[0]);
+    q = (q * so3::exp(ahead * so3::log(w.orientation[0].conjugate() * q))).normalized();
+    p += ahead * (p - w.position[0]);
+  }
+  bool clamped = project_rotation(so3::aligned_to(s.orientation, q), q, config_.epsilon_r);
+  if (have_emitted_) q = so3::aligned_to(q, last_emitted_);
+  last_emitted_ = q;
+  if (positions_) clamped = project_position(s.position, p, config_.epsilon_t) || clamped;
+  if (clamped) ++counters_.clamped;
+  ++counters_.emitted;
+  FairedPose out;
+  out.stream_id = s.stream_id;
+  out.sequence = s.sequence;
+  out.time = s.time + config_.horizon_s;
+  out.orientation = q;
+  out.position = positions_ ? p : Vec3::Zero();
+  out.measured = s.orientation;
+  out.measured_position = s.position;
+  out.flags = s.flags | (clamped ? kClamped : 0u);
+  out.step = s.time - (carried_time_ >= 0.0 ? carried_time_ : w.time[1]);
+  carried_time_ = s.time;
+  return out;
+}
+
+// A pose the window emitted at lag 0, for the repeats after it; its step is from the pose
+// before it, a carried repeat's if there was one.
+void FairingWindow::note_window_pose(FairedPose& pose, double time) {
+  if (config_.lag != 0) return;
+  if (carried_time_ >= 0.0) pose.step = time - carried_time_;
+  if (afresh_from_ >= 0.0) pose.step = time - afresh_from_;
+  carried_time_ = afresh_from_ = -1.0;
+  WindowPoses& w = window_poses_;
+  w.orientation[0] = w.orientation[1];
+  w.position[0] = w.position[1];
+  w.time[0] = w.time[1];
+  w.orientation[1] = pose.orientation;
+  w.position[1] = pose.position;
+  w.time[1] = time;
+  w.count = std::min(w.count + 1, 2);
+}
+
 int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
+  // A stream read faster than its source updates repeats each measurement: the window takes the
+  // measurements alone (their rate is the source's) and each repeat is carried forward
+  // (repeated_measurements.hpp).
+  int count = 0;
+  const bool repeat = repeats_.note(sample);
+  if (carries_repeats() && repeats_.repeating() != repeating_) {
+    repeating_ = repeats_.repeating();
+    count = start_afresh(out);
+  }
+  if (repeating_ && repeat && window_poses_.count > 0 && sample.time > last_time_ &&
+      sample.time - last_time_ <= config_.gate.gap_threshold) {
+    out[static_cast<std::size_t>(count++)] = carry_forward(sample);
+    return count;
+  }
   Sample s = sample;
   const GateVerdict verdict = gate_.check(s);
-  if (verdict != GateVerdict::Accept && verdict != GateVerdict::AcceptAfterGap) return 0;
-  int count = 0;
+  if (verdict != GateVerdict::Accept && verdict != GateVerdict::AcceptAfterGap) return count;
   const double step = have_time_ ? s.time - last_time_ : 0.0;  // across a gap too
   const double new_rate = prepared_ && rate_measured_ ? rate_change(step) : 0.0;
   // A gap, a change of rate, or a change between samples with and without positions or gyro,
@@ -739,8 +837,9 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   const bool bridge = aided_ && missing_gyro_run_ < kMaxBridgedGyroReadings;
   if (n_ > 0 && (verdict == GateVerdict::AcceptAfterGap || new_rate > 0.0 || s.has_position() != positions_ ||
                  (gyro_aided(s) != aided_ && !bridge))) {
-    count = emit_pending(out);
+    count += emit_pending(out.subspan(static_cast<std::size_t>(count)));
     ++counters_.restarts;
+    window_poses_.count = 0;
   }
   if (new_rate > 0.0) {
     ++counters_.rate_changes;
@@ -807,7 +906,10 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   last_z_ = z_[static_cast<std::size_t>(n_ - 1)];
   last_p_ = s.position;
   last_has_position_ = s.has_position();
-  if (k >= 0) out[static_cast<std::size_t>(count++)] = emit(k);
+  if (k >= 0) {
+    out[static_cast<std::size_t>(count)] = emit(k);
+    note_window_pose(out[static_cast<std::size_t>(count++)], s.time);
+  }
   if (emit_measured) put_held(held_z, held_p, held, dt);
   return count;
 }

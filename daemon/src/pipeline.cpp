@@ -82,6 +82,7 @@ void store_engine_state(StreamCounters& c, const EngineState& e) {
   constexpr auto relaxed = std::memory_order_relaxed;
   c.engine_rate_hz.store(e.rate_hz, relaxed);
   c.engine_window.store(e.window, relaxed);
+  c.engine_repeating.store(e.repeating, relaxed);
   for (const bool rotation : {true, false}) {
     const ChannelAdaptation& from = rotation ? e.rotation : e.position;
     StreamCounters::Channel& to = rotation ? c.rotation : c.position;
@@ -107,6 +108,7 @@ EngineState load_engine_state(const StreamCounters& c) {
   EngineState e;
   e.rate_hz = c.engine_rate_hz.load(relaxed);
   e.window = c.engine_window.load(relaxed);
+  e.repeating = c.engine_repeating.load(relaxed);
   for (const bool rotation : {true, false}) {
     const StreamCounters::Channel& from = rotation ? c.rotation : c.position;
     ChannelAdaptation& to = rotation ? e.rotation : e.position;
@@ -521,6 +523,7 @@ bool Pipeline::stream_pass(Stream& s) {
   s.counters.outliers_released.store(w.released, std::memory_order_relaxed);
   s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
   s.counters.rate_changes.store(w.rate_changes, std::memory_order_relaxed);
+  s.counters.repeated.store(w.repeated, std::memory_order_relaxed);
   s.counters.gyro.bridged.store(w.gyro_bridged, std::memory_order_relaxed);
   store_engine_state(s.counters, s.window.state());
   if (s.gyro_pairing) {
@@ -703,6 +706,7 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.outliers_released = get(s.counters.outliers_released);
     st.restarts = get(s.counters.restarts);
     st.rate_changes = get(s.counters.rate_changes);
+    st.repeated = get(s.counters.repeated);
     st.gyro_bridged = get(s.counters.gyro.bridged);
     st.engine = load_engine_state(s.counters);
     st.publish_dropped = s.pose_ring.dropped();

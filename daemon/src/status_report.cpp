@@ -128,6 +128,11 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
       std::snprintf(buf, sizeof buf, ", rate changes %" PRIu64 " (of the restarts)", s.rate_changes);
       lines.back() += buf;
     }
+    if (s.repeated > 0) {  // a source read faster than it updates (repeated_measurements.hpp)
+      std::snprintf(buf, sizeof buf, ", repeated %" PRIu64 " (carried forward; %s)", s.repeated,
+                    s.engine.repeating ? "the rate is the source's" : "not repeating now");
+      lines.back() += buf;
+    }
     if (s.raw_unfused > 0) {  // a raw IMU source without a fusion stage: say why nothing is faired
       std::snprintf(buf, sizeof buf, ", raw-only %" PRIu64 " (not faired: no orientation, no fusion stage)", s.raw_unfused);
       lines.back() += buf;
@@ -178,6 +183,10 @@ std::string status_line(const std::vector<StreamStats>& now, const std::vector<S
       const ChannelAdaptation& r = s.engine.rotation;
       std::snprintf(buf, sizeof buf, " fc %.3gHz%s", r.cutoff_hz, !r.adaptive ? "" : r.rest_averaged ? " (adapted, at rest, averaged)" : r.at_rest ? " (adapted, at rest)" : " (adapted)");
       out += buf;
+      if (s.engine.repeating) {
+        std::snprintf(buf, sizeof buf, " source %.3gHz (repeated)", s.engine.rate_hz);
+        out += buf;
+      }
     }
     if (s.raw_unfused > 0) {
       std::snprintf(buf, sizeof buf, " raw-only %" PRIu64 " unfused", s.raw_unfused);

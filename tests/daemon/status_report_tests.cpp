@@ -72,6 +72,28 @@ TEST(StatusReport, AChangeOfRateShowsAmongTheRestarts) {
   EXPECT_NE(json.find("\"restarts\":3,\"rate_changes\":1,"), std::string::npos) << json;
 }
 
+// A source read faster than it updates (repeated_measurements.hpp): its repeats carried forward
+// show in the counter line and the control reply once there are some, and while the stream
+// repeats, STATUS= gives the source's rate the window runs at.
+TEST(StatusReport, RepeatsCarriedForwardShowWithTheSourcesRate) {
+  StreamStats s = stream(1, "head", 2000);
+  s.engine.rate_hz = 250.0;
+  EXPECT_EQ(counter_lines({s}, {}, 0.0)[0].find("repeated"), std::string::npos);
+  EXPECT_EQ(status_line({s}, {}, 1.0).find("source"), std::string::npos);
+  s.repeated = 1500;
+  s.engine.repeating = true;
+  s.engine.rate_hz = 62.5;
+  const auto lines = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(lines[0].find(", repeated 1500 (carried forward; the rate is the source's)"), std::string::npos) << lines[0];
+  EXPECT_NE(status_line({s}, {}, 1.0).find(" source 62.5Hz (repeated)"), std::string::npos) << status_line({s}, {}, 1.0);
+  const std::string json = streams_member({s}, {}, 1.0);
+  EXPECT_NE(json.find("\"repeated\":1500,"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"repeating\":true"), std::string::npos) << json;
+  s.engine.repeating = false;  // it stopped: the count stays, the source's rate goes
+  EXPECT_NE(counter_lines({s}, {}, 0.0)[0].find(", repeated 1500 (carried forward; not repeating now)"), std::string::npos);
+  EXPECT_EQ(status_line({s}, {}, 1.0).find("source"), std::string::npos);
+}
+
 // [stream.engine] gyro_stream: the gyro part names the source and its matches from the start,
 // before any interval was aided, and STATUS= says how many samples found no reading.
 TEST(StatusReport, GapsBridgedAndPassedThroughShowWhenBridging) {

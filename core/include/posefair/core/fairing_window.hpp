@@ -33,6 +33,7 @@
 #include "posefair/core/fairing_operators.hpp"
 #include "posefair/core/gyro_aiding.hpp"
 #include "posefair/core/outlier_guard.hpp"
+#include "posefair/core/repeated_measurements.hpp"
 #include "posefair/core/rest_line.hpp"
 #include "posefair/core/sample.hpp"
 #include "posefair/core/sample_gate.hpp"
@@ -119,6 +120,9 @@ struct WindowCounters {
   std::uint64_t gyro_bridged = 0;  // readings missing from a gyro-aided window, bridged without a restart
   std::uint64_t held = 0;          // outliers held at the prediction (rotation, position or both)
   std::uint64_t released = 0;      // of those, taken back: the next sample showed a motion starting
+  // Samples that repeated the measurement before, in a stream read faster than its source
+  // updates (repeated_measurements.hpp): carried forward from the poses before, not faired.
+  std::uint64_t repeated = 0;
 };
 
 // What the engine is doing now: the rate and window it settled on and, per channel, what the
@@ -133,8 +137,11 @@ struct ChannelAdaptation {
   bool rest_averaged = false;  // at rest and averaged over seconds, not the window (rest_line.hpp)
 };
 struct EngineState {
-  double rate_hz = 0.0;    // given or measured; 0 until known
+  double rate_hz = 0.0;    // given or measured; 0 until known (the source's while repeating)
   int window = 0;          // W in use
+  // The stream repeats each measurement (read faster than its source updates): the window
+  // holds the measurements alone, at the source's rate, and each repeat is carried forward.
+  bool repeating = false;
   ChannelAdaptation rotation, position;
   GyroAidingState gyro;
 };
@@ -233,6 +240,10 @@ class FairingWindow {
   Vec3 rest_blend(Channel& ch, int k, const Vec3& window, double dt);
   void linear_emission_estimate(int k, double dt);
   void predict_from_last_step(int k, double step);
+  bool carries_repeats() const;
+  int start_afresh(std::span<FairedPose> out);
+  FairedPose carry_forward(const Sample& s);
+  void note_window_pose(FairedPose& pose, double time);
   void check_continuity_stability() const;
   void solve();
   void linear_window();
@@ -263,6 +274,18 @@ class FairingWindow {
   Quat last_z_ = Quat::Identity();
   Vec3 last_p_ = Vec3::Zero();
   bool last_has_position_ = false;
+  // A stream that repeats its measurements: what tells it, and the last two poses the window
+  // emitted (lag 0) with their samples' times, which a repeat carries forward.
+  RepeatedMeasurements repeats_;
+  bool repeating_ = false;  // the window holds the measurements alone, and carries the repeats
+  struct WindowPoses {
+    std::array<Quat, 2> orientation{Quat::Identity(), Quat::Identity()};
+    std::array<Vec3, 2> position{Vec3::Zero(), Vec3::Zero()};
+    std::array<double, 2> time{};
+    int count = 0;  // since the window (re)started, up to 2
+  } window_poses_;
+  double carried_time_ = -1.0;  // the newest carried repeat's time since the window's last pose (< 0: none)
+  double afresh_from_ = -1.0;   // the last pose's time, when the window started afresh since (< 0: it did not)
 
   // The rate: given, or measured from the first intervals (stream_rate.hpp) and checked on
   // in blocks of kMaxRateIntervals steps (rate_change).

@@ -1,0 +1,54 @@
+#pragma once
+// A stream read faster than its source updates: each measurement repeated until the next.
+//
+// A tracker that measures at 60 Hz but is polled at 250 Hz (a webcam head tracker feeding a
+// 250 Hz filter, a USB device read faster than its reports change) delivers every measurement
+// four or five times, exactly. Read at the stream's rate, such a stream has its noise spread
+// over a quarter of the samples and its motion in steps: the engine takes the steps for motion
+// and barely smooths it (docs/engine.md, "Streams read faster than their source"). Its samples
+// are evenly spaced at the source's rate once the repeats are set aside, so the engine fairs the
+// measurements alone and carries each repeat forward from the poses before it.
+//
+// Exact repeats also come from a quantised sensor whose value did not change, at random: those
+// are measurements. They are told apart by regularity: a source read at a steady rate repeats
+// each measurement nearly the same number of times (⌊f/f_s⌋ or one more), and a stream is taken
+// as repeating its source only after kRepeatBlocks blocks of kRepeatBlockRuns measurements in
+// a row in which every run (the measurement and its repeats) is within kRepeatRunSpread of the
+// shortest and the runs average at least kMinMeanRun samples. Chance repeats seldom pass both:
+// with a repeat 1 time in 3, 64 runs all of 1 or 2 samples come once in 1900, and each block's
+// 32 of them half 2s once in 500 more (about once in 10⁹ pairs of blocks). One block that fails
+// ends it, and so does one run far longer than the block's longest (a tracker that stalled
+// repeats its last report).
+// No allocation; O(1) per sample.
+#include "posefair/core/sample.hpp"
+
+namespace posefair {
+
+inline constexpr int kRepeatBlockRuns = 32;
+inline constexpr int kRepeatBlocks = 2;
+inline constexpr double kMinMeanRun = 1.5;
+
+class RepeatedMeasurements {
+ public:
+  // Notes an accepted sample and says whether it repeats the measurement before it exactly
+  // (orientation and position as given; never a sample with raw inertial readings, which are
+  // measured anew each time).
+  bool note(const Sample& s);
+  // Whether the stream repeats its measurements (above): its rate is its source's.
+  bool repeating() const { return repeating_; }
+  void reset();
+
+ private:
+  void end_run();
+  bool have_ = false;
+  Quat orientation_ = Quat::Identity();
+  Vec3 position_ = Vec3::Zero();
+  std::uint32_t flags_ = 0;
+  int run_ = 0;  // samples in the current run: the measurement and its repeats so far
+  int runs_ = 0, shortest_ = 0, longest_ = 0;
+  long samples_ = 0;  // in this block's runs
+  int blocks_ = 0;    // regular blocks in a row
+  bool repeating_ = false;
+};
+
+}  // namespace posefair
