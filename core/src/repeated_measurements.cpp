@@ -42,13 +42,24 @@ void RepeatedMeasurements::end_run() {
     longest_ = std::max(longest_, run_);
   }
   samples_ += run_;
+  squares_ += static_cast<long>(run_) * run_;
+  singles_ += run_ == 1 ? 1 : 0;
   if (++runs_ < kRepeatBlockRuns) return;
-  const bool regular = longest_ - shortest_ <= run_spread(shortest_) &&
-                       static_cast<double>(samples_) >= kMinMeanRun * kRepeatBlockRuns;
+  const double n = kRepeatBlockRuns;
+  const double mean = static_cast<double>(samples_) / n;
+  const double variance = static_cast<double>(squares_) / n - mean * mean;
+  // Steady: every run within the spread of the shortest. Jittered (a source whose reports come a
+  // few milliseconds early or late): hardly a run of one sample, and the runs' spread under a
+  // third of their mean. Chance repeats have runs of one sample (one in 2 at a repeat 1 time in
+  // 2, one in 5 at 4 in 5) and a spread about their mean (a geometric run length's).
+  const bool steady = longest_ - shortest_ <= run_spread(shortest_);
+  const bool jittered = singles_ <= 1 && 9.0 * variance <= mean * mean;
+  const bool regular = mean >= kMinMeanRun && (steady || jittered);
   blocks_ = regular ? std::min(blocks_ + 1, kRepeatBlocks) : 0;
   repeating_ = blocks_ >= kRepeatBlocks;
   runs_ = 0;
-  samples_ = 0;
+  samples_ = squares_ = 0;
+  singles_ = 0;
 }
 
 void RepeatedMeasurements::reset() { *this = RepeatedMeasurements{}; }

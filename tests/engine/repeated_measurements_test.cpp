@@ -69,9 +69,9 @@ TEST(RepeatedMeasurements, ASourceReadFasterIsTakenAfterTwoRegularBlocks) {
 }
 
 TEST(RepeatedMeasurements, AQuantisedSensorsChanceRepeatsAreMeasurements) {
-  // A still sensor whose value stays the same at random (1 time in 3, 1 in 2, 2 in 3): its runs
+  // A still sensor whose value stays the same at random (1 time in 3 up to 9 in 10): its runs
   // are as long as chance makes them, and it is never taken for a source read faster.
-  for (const double p : {1.0 / 3.0, 0.5, 2.0 / 3.0}) {
+  for (const double p : {1.0 / 3.0, 0.5, 2.0 / 3.0, 0.8, 0.9}) {
     SCOPED_TRACE(p);
     std::mt19937_64 rng(7);
     std::bernoulli_distribution same(p);
@@ -85,6 +85,28 @@ TEST(RepeatedMeasurements, AQuantisedSensorsChanceRepeatsAreMeasurements) {
     }
     EXPECT_NEAR(repeats / 200000.0, p, 0.01);  // the stream did repeat, by chance
   }
+}
+
+TEST(RepeatedMeasurements, ASourceWhoseReportsComeEarlyOrLateIsTakenToo) {
+  // A 60 Hz source whose reports each come up to 3 ms early or late (uniform), read at 250 Hz:
+  // runs of 2 to 6 samples, which the steady rule alone refuses (it did until 2026-12-06).
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> late(-0.003, 0.003);
+  std::vector<double> report;
+  for (int k = 0; k < 600; ++k) report.push_back(k / 60.0 + late(rng));
+  RepeatedMeasurements r;
+  std::size_t k = 0;
+  int repeating = 0, samples = 0;
+  for (int i = 0; i < 2500; ++i) {
+    const double t = i / 250.0;
+    while (k + 1 < report.size() && report[k + 1] <= t) ++k;
+    r.note(at(t, so3::exp(Vec3(0.01 * static_cast<double>(k), 0.0, 0.0))));
+    if (t >= 2.0) {
+      ++samples;
+      repeating += r.repeating() ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(repeating, samples);  // from 2 s on (two blocks: 1.1 s)
 }
 
 TEST(RepeatedMeasurements, NothingRepeatsInAStreamOfMeasurementsOrOfInertialReadings) {
