@@ -184,15 +184,20 @@ TEST(RepeatedMeasurementsInTheEngine, AStreamReadFasterThanItsSourceIsFairedAtTh
 }
 
 TEST(RepeatedMeasurementsInTheEngine, ARepeatIsCarriedForwardWithinItsBoundAndItsStep) {
-  // Every pose within ε of what was measured, each pose's step the time since the one before,
-  // and a repeat carried on from the poses before for at most one of the source's intervals: a
-  // source that stalls (here 0.2 s) is held, not extrapolated.
+  // Every pose within ε of what was measured, rotation and position, each pose's step the time
+  // since the one before, and a repeat carried on from the poses before for at most one of the
+  // source's intervals: a source that stalls (here 0.2 s) is held, not extrapolated.
   std::vector<Quat> truth;
   std::vector<Sample> in = read_faster(60.0, 250.0, 6.0, 0.01, 5, truth);
   const std::size_t stall = 4 * 250;
   for (std::size_t i = stall + 1; i < stall + 50; ++i) in[i].orientation = in[stall].orientation;
+  for (Sample& s : in) {  // a position measured with each orientation (and repeated with it)
+    s.position = 100.0 * so3::log(s.orientation);
+    s.flags |= kHasPosition;
+  }
   WindowConfig c;
   c.epsilon_r = 0.004;
+  c.epsilon_t = 0.4;
   FairingWindow w(c);
   std::vector<FairedPose> out(1);
   std::vector<FairedPose> poses;
@@ -202,6 +207,7 @@ TEST(RepeatedMeasurementsInTheEngine, ARepeatIsCarriedForwardWithinItsBoundAndIt
     poses.push_back(out[0]);
     repeating.push_back(w.state().repeating ? 1 : 0);
     EXPECT_LE(so3::dist(out[0].orientation, out[0].measured), c.epsilon_r + 1e-12);
+    EXPECT_LE((out[0].position - out[0].measured_position).norm(), c.epsilon_t + 1e-9);
   }
   EXPECT_GT(w.counters().repeated, 0u);
   EXPECT_GT(w.counters().clamped, 0u);  // the bound did bind
@@ -210,9 +216,12 @@ TEST(RepeatedMeasurementsInTheEngine, ARepeatIsCarriedForwardWithinItsBoundAndIt
   // over twice the longest (5) and one ends the repeating: then the repeats are measurements.
   ASSERT_TRUE(repeating[stall + 10]);
   EXPECT_FALSE(repeating[stall + 11]);
-  for (std::size_t i = stall + 6; i <= stall + 10; ++i)
+  for (std::size_t i = stall + 6; i <= stall + 10; ++i) {
     EXPECT_LT(so3::rotation_angle(poses[i].orientation, poses[stall + 5].orientation), 1e-12) << i;
+    EXPECT_LT((poses[i].position - poses[stall + 5].position).norm(), 1e-9) << i;
+  }
   EXPECT_GT(so3::rotation_angle(poses[stall + 1].orientation, poses[stall].orientation), 0.0);
+  EXPECT_GT((poses[stall + 1].position - poses[stall].position).norm(), 0.0);
   EXPECT_TRUE(repeating.back());  // and taken again after
 }
 
