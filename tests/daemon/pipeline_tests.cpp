@@ -657,6 +657,38 @@ TEST(Pipeline, AStillTrackerIsReportedAtRestAndAveragedOverSeconds) {
   }
 }
 
+// A tracker that measures at 50 Hz read at 200 Hz, each measurement four times: the daemon
+// reports the repeats carried forward and the source's rate the window runs at; with a lag the
+// repeats stay in the window, each a measurement.
+TEST(Pipeline, AStreamReadFasterThanItsSourceIsReportedRepeating) {
+  ScratchDir dir;
+  std::vector<Sample> held;
+  for (int k = 0; k < 1200; ++k) {
+    Sample s;
+    s.stream_id = 1;
+    s.sequence = static_cast<std::uint64_t>(k);
+    s.time = k / 200.0;
+    const int m = k / 4;  // the measurement shown
+    s.orientation = so3::exp(Vec3(0.3 * std::sin(m * 0.05), 0.01 * ((m * 7) % 5 - 2) / 2.0, 0.0));
+    held.push_back(s);
+  }
+  write_imu_log(dir / "in.pflog", held);
+  for (const std::string keys : {"", "lag = 1\n"}) {
+    SCOPED_TRACE(keys.empty() ? "defaults" : keys);
+    const StreamStats st = run_to_end(parse_config(replayed_tracker(dir / "in.pflog", keys), "/virtual/held.toml"));
+    EXPECT_EQ(st.emitted, held.size());
+    if (keys.empty()) {
+      EXPECT_TRUE(st.engine.repeating);
+      EXPECT_NEAR(st.engine.rate_hz, 50.0, 1.0);
+      EXPECT_GT(st.repeated, held.size() / 2);
+    } else {
+      EXPECT_FALSE(st.engine.repeating);
+      EXPECT_NEAR(st.engine.rate_hz, 200.0, 1.0);
+      EXPECT_EQ(st.repeated, 0u);
+    }
+  }
+}
+
 // The still tracker with three samples thrown 0.2 rad off: the engine holds each (the outlier
 // guard is on by default) and the stats say so; `outlier_threshold = 0` holds none.
 TEST(Pipeline, OutliersHeldByTheEngineReachTheStats) {
