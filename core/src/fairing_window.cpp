@@ -757,6 +757,7 @@ int FairingWindow::start_afresh(std::span<FairedPose> out) {
     ch->mu = 0.0;
     ch->level = 0.0;
   }
+  rest_chart_ready_ = false;
   rot_guard_ = OutlierGuard(outlier_threshold(config_), 0.5);
   pos_guard_ = OutlierGuard(outlier_threshold(config_), 1.0);
   return count;
