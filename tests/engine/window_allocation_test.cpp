@@ -69,6 +69,7 @@ struct Case {
   bool defaults = false;  // the engine's defaults: the rate is measured, and W, the rows and
                           // the adaptation are set, inside the measured run
   bool gyro = false;      // the samples carry a gyro: gyro-aided fairing with its estimates
+  bool held = false;      // each measurement repeated 4 times: the window at the source's rate, repeats carried forward
 };
 
 TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
@@ -80,6 +81,7 @@ TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
       {"sweeps window bound", WindowSolver::DampedSweeps, BoundPolicy::Window},
       {"defaults (adaptive)", WindowSolver::Linear, BoundPolicy::Sample, true},
       {"defaults, gyro-aided", WindowSolver::Linear, BoundPolicy::Sample, true, true},
+      {"defaults, a stream read faster than its source", WindowSolver::Linear, BoundPolicy::Sample, true, false, true},
   };
   constexpr std::size_t kWarmUp = 300, kMeasured = 10000;
   for (const Case& c : cases) {
@@ -110,6 +112,13 @@ TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
         for (std::size_t i = 0; i < part->size(); ++i) {
           (*part)[i].gyro = Vec3(0.3 * std::sin(0.01 * static_cast<double>(i)), 0.2, -0.1);
           (*part)[i].flags |= kHasGyro;
+        }
+    if (c.held)
+      for (auto* part : {&warm, &measured})
+        for (std::size_t i = 0; i < part->size(); ++i) {
+          const Sample& shown = (*part)[i - i % 4];
+          (*part)[i].orientation = shown.orientation;
+          (*part)[i].position = shown.position;
         }
     Sample bad = measured[5000];
     bad.orientation.coeffs() *= 2.0;  // rejected by the gate
@@ -143,7 +152,12 @@ TEST(WindowAllocation, SteadyStatePushAndFlushNeverAllocate) {
       EXPECT_TRUE(w.state().gyro.active);
       EXPECT_GT(w.state().gyro.intervals, kMeasured / 2);
     }
-    EXPECT_EQ(w.counters().restarts, 1u);
+    if (c.held) {
+      EXPECT_GT(w.counters().repeated, kMeasured / 2);
+      EXPECT_GE(w.counters().restarts, 2u);  // the gap, and starting afresh at the source's rate
+    } else {
+      EXPECT_EQ(w.counters().restarts, 1u);
+    }
     EXPECT_EQ(w.gate_counters().rejected_non_unit, 1u);
     EXPECT_GT(w.counters().clamped, 0u);
   }
