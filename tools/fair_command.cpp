@@ -114,7 +114,7 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
     };
     channel("rotation", st.rotation, "rad");
     if (in.has_position()) channel("position", st.position, "units");
-    std::printf("samples  %llu emitted, %llu clamped to the bound, %llu restarts after gaps or changes of rate (%llu for a "
+    std::printf("samples  %llu emitted, %llu clamped to the bound, %llu restarts after gaps, changes of rate or of repeating (%llu for a "
                 "change of rate), %llu dropped, %llu rejected\n",
                 static_cast<unsigned long long>(r.counters.emitted), static_cast<unsigned long long>(r.counters.clamped),
                 static_cast<unsigned long long>(r.counters.restarts), static_cast<unsigned long long>(r.counters.rate_changes),
