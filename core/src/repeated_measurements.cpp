@@ -9,6 +9,7 @@ namespace {
 // divide the stream's (4 or 5 repeats of a 60 Hz source read at 250 Hz), more for long runs,
 // whose polling jitter moves a report by a sample now and then.
 int run_spread(int shortest) { return 1 + shortest / 3; }
+constexpr int kLongestRun = 1 << 30;
 }  // namespace
 
 bool RepeatedMeasurements::note(const Sample& s) {
@@ -16,7 +17,7 @@ bool RepeatedMeasurements::note(const Sample& s) {
                       s.flags == flags_ && s.orientation.coeffs() == orientation_.coeffs() &&
                       (!s.has_position() || s.position == position_);
   if (repeat) {
-    ++run_;
+    run_ = std::min(run_ + 1, kLongestRun);  // a source stalled for weeks cannot overflow it
     // A run far longer than the block's longest is no steady source (a tracker that stalled
     // and repeats its last report): it ends the repeating at once, not at the block's end.
     if (repeating_ && run_ > 2 * longest_ + 1) {
@@ -61,7 +62,5 @@ void RepeatedMeasurements::end_run() {
   samples_ = squares_ = 0;
   singles_ = 0;
 }
-
-void RepeatedMeasurements::reset() { *this = RepeatedMeasurements{}; }
 
 }  // namespace posefair

@@ -5,7 +5,7 @@
 // 250 Hz filter, a USB device read faster than its reports change) delivers every measurement
 // four or five times, exactly. Read at the stream's rate, such a stream has its noise spread
 // over a quarter of the samples and its motion in steps: the engine takes the steps for motion
-// and barely smooths it (docs/engine.md, "Streams read faster than their source"). Its samples
+// and barely smooths it (docs/engine.md, "Streams resampled from a lower rate"). Its samples
 // are evenly spaced at the source's rate once the repeats are set aside, so the engine fairs the
 // measurements alone and carries each repeat forward from the poses before it.
 //
@@ -16,13 +16,13 @@
 // a row whose runs (a measurement and its repeats) average at least kMinMeanRun samples and are
 // either steady (every run within a spread of the shortest) or jittered (a source whose reports
 // come a little early or late: at most one run of a single sample, and the runs' standard
-// deviation within a third of their mean). Chance repeats seldom pass: the steady rule
-// with a repeat 1 time in 3, 64 runs all of 1 or 2 samples come once in 1900, and each block's
-// 32 of them half 2s once in 500 more (about once in 10⁹ pairs of blocks); the jittered rule,
-// since their runs of one sample are common (half of them at a repeat 1 time in 2, a fifth at 4
-// in 5) and their runs spread about as widely as their mean (a geometric length's). One block that fails
-// ends it, and so does one run far longer than the block's longest (a tracker that stalled
-// repeats its last report).
+// deviation within a third of their mean). Chance repeats seldom pass. The steady rule: with a
+// repeat 1 time in 3, 64 runs all of 1 or 2 samples come once in 1900, and each block's 32 of
+// them half 2s once in 500 more (about once in 10⁹ pairs of blocks). The jittered rule hardly
+// ever: their runs of one sample are common (half of them at a repeat 1 time in 2, a fifth at 4
+// in 5), and their runs spread about as widely as their mean (a geometric length's). One block
+// that fails ends it, and so does one run far longer than the block's longest (a tracker that
+// stalled repeats its last report).
 // No allocation; O(1) per sample.
 #include "posefair/core/sample.hpp"
 
@@ -34,13 +34,12 @@ inline constexpr double kMinMeanRun = 1.5;
 
 class RepeatedMeasurements {
  public:
-  // Notes an accepted sample and says whether it repeats the measurement before it exactly
+  // Notes a sample (before the gate) and says whether it repeats the measurement before it exactly
   // (orientation and position as given; never a sample with raw inertial readings, which are
   // measured anew each time).
   bool note(const Sample& s);
   // Whether the stream repeats its measurements (above): its rate is its source's.
   bool repeating() const { return repeating_; }
-  void reset();
 
  private:
   void end_run();
