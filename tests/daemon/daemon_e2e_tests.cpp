@@ -863,6 +863,11 @@ TEST(DaemonSerial, AGoldenLogThroughAPtyIsFairedAndTheLinkIsReported) {
   EXPECT_NE(d.err().find(", frames 288, bad 9, resyncs 14 (skipped 3871 bytes)"), std::string::npos) << d.err();
 
   // Unplug: the stream stays, the outage is logged once and shown in STATUS= and the counters.
+  // udev removes the device's link with it: pointed nowhere, so that the daemon's reopening
+  // cannot find a pty another test opens under the reused /dev/pts number (run beside
+  // SerialDriver.UnplugAndReplug…, it did, and counted a reconnect).
+  fs::remove(link);
+  fs::create_symlink(dir / "unplugged", link);
   pty.reset();
   ASSERT_TRUE(wait_for_log_or_exit(d, "stream 'imu': lost the device", 5s)) << d.err();
   const std::vector<std::string> messages = notify.drain(2500ms);
