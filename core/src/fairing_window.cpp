@@ -1,6 +1,7 @@
 #include "posefair/core/fairing_window.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
@@ -216,6 +217,7 @@ FairingWindow::FairingWindow(const WindowConfig& config)
   pos_.adaptive = linear && smoothing_source(config, false) == SmoothingSource::Adaptive;
   if (rot_.adaptive || pos_.adaptive) {
     levels_.assign(kMaxSmoothingLevels, make_emission_row(capacity_));
+    if (config.lag == 0 && config.adaptation.prediction_check) next_rows_.assign(kMaxSmoothingLevels, make_emission_row(capacity_));
     level_tail_bias_.assign(static_cast<std::size_t>(kMaxSmoothingLevels * capacity_), 0.0);
   }
   if (!linear) {
@@ -309,6 +311,18 @@ void FairingWindow::prepare(double rate_hz) {
         if (mu > kMaxSmoothing) break;
         builder_.build(w_, mu, target_spec_, levels_[static_cast<std::size_t>(level_count_++)]);
       }
+      if (!next_rows_.empty()) {
+        // The check's predictions: each level's fit one sample past the newest.
+        const EmissionTarget next{m, 0, 1.0, 0.0};
+        for (int l = 0; l < level_count_; ++l)
+          builder_.build(w_, levels_[static_cast<std::size_t>(l)].mu, next, next_rows_[static_cast<std::size_t>(l)]);
+        // Compared where the levels are chosen again (every sample, or every 4 ms at higher rates),
+        // at most PredictionCheck::kChecksPerSecond times a second.
+        const double evaluations = std::min({rate_hz, MotionNoiseEstimator::kMotionRefreshes / config_.adaptation.motion_time_s,
+                                             PredictionCheck::kChecksPerSecond});
+        rot_.check.configure(evaluations);
+        pos_.check.configure(evaluations);
+      }
       const int k = w_ - 1 - config_.lag;  // the emitted sample
       for (int l = 0; l + 1 < level_count_; ++l)
         level_shared_gain_[static_cast<std::size_t>(l)] =
@@ -339,6 +353,8 @@ void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
     ch.mu = 0.0;
     return;
   }
+  const bool checked = checks_prediction(ch);
+  if (checked) compare_predictions(ch, zeta);
   if (!refreshed) return;  // the level follows the motion estimate's refreshes
   // A motion that stopped and is still in the window: each level's drag towards it counts too.
   const MotionNoiseEstimator::StoppedMotion stopped = estimator.stopped_motion(w_);
@@ -348,8 +364,36 @@ void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
                                                               static_cast<std::size_t>(level_count_))
           : std::span<const double>{};
   const double margin = config_.adaptation.motion_margin;
-  ch.level = best_level(levels_, level_shared_gain_, level_count_, estimator.noise_variance(),
-                        margin * estimator.motion_variance(), tail, margin * stopped.motion_var);
+  auto level_at = [&](double noise_scale) {
+    return best_level(levels_, level_shared_gain_, level_count_, noise_scale * estimator.noise_variance(),
+                      margin * estimator.motion_variance(), tail, margin * stopped.motion_var);
+  };
+  ch.level = level_at(1.0);
+  if (checked) {
+    // The candidates' levels and predictions, at most PredictionCheck::kChecksPerSecond times a
+    // second (at 1 kHz the levels are chosen every 4 ms); in between the one in use only. The
+    // same at rest (no motion: the heaviest for any noise), and pass-through once one is (less
+    // noise only lightens).
+    PredictionCheck::State& s = ch.check.state();
+    s.since_check_s += dt;
+    const double period = 1.0 / PredictionCheck::kChecksPerSecond;
+    const bool check = s.since_check_s >= (1.0 - 1e-9) * period;
+    ch.candidate_level[0] = ch.level;
+    for (int j = 1; j < PredictionCheck::kCandidates; ++j) {
+      if (!check && j != ch.check.choice()) continue;
+      const double before = ch.candidate_level[static_cast<std::size_t>(j - 1)];
+      ch.candidate_level[static_cast<std::size_t>(j)] = estimator.at_rest()         ? ch.level
+                                                        : check && before == 0.0 ? 0.0
+                                                                                 : level_at(PredictionCheck::scale(j));
+    }
+    ch.level = ch.candidate_level[static_cast<std::size_t>(ch.check.choice())];
+    if (check) {
+      // (Its remainder kept, so that a stream whose refreshes are not a multiple of the period is
+      // checked kChecksPerSecond times a second on average.)
+      s.since_check_s = s.since_check_s >= 2.0 * period ? 0.0 : s.since_check_s - period;
+      predict_next(ch, zeta);
+    }
+  }
   // The μ a window still filling uses, and the one reported: geometric between the levels
   // (linear from the pass-through level 0).
   const int i = static_cast<int>(ch.level);
@@ -357,6 +401,52 @@ void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
   const double a = levels_[static_cast<std::size_t>(i)].mu;
   const double b = i + 1 < level_count_ ? levels_[static_cast<std::size_t>(i + 1)].mu : a;
   ch.mu = a > 0.0 ? a * std::pow(b / a, f) : f * b;
+}
+
+// The check by the next measurement (prediction_check.hpp): at lag 0, where the adaptation's
+// choice is what goes out; not on a gyro-aided rotation (its own estimator, a residual).
+bool FairingWindow::checks_prediction(const Channel& ch) const {
+  return !next_rows_.empty() && !(&ch == &rot_ && aided_);
+}
+
+// The newest measurement against each candidate's prediction of it. Not where the adaptation's
+// level is not what went out: at rest (the rest line) or a motion leaving rest (as measured). A
+// held sample is compared as the window holds it (hold_outliers: a release puts the check back
+// with the adaptation and compares the measurement).
+void FairingWindow::compare_predictions(Channel& ch, std::span<const Vec3> zeta) {
+  PredictionCheck::State& s = ch.check.state();
+  if (!s.predicted) return;
+  s.predicted = false;
+  if (n_ != w_ || zeta.size() != static_cast<std::size_t>(w_ - 1) || ch.estimator.at_rest() || ch.rest.resting ||
+      ch.rest.leaving > 0)
+    return;
+  const Vec3& newest = zeta.back();
+  std::array<double, PredictionCheck::kCandidates> errors{};
+  for (std::size_t j = 0; j < errors.size(); ++j) errors[j] = (newest - s.prediction[j]).squaredNorm() / 3.0;
+  ch.check.note(errors);
+}
+
+// Each candidate's prediction of the next measurement, as an increment from the newest (a full
+// window, not at rest). Candidates at the same level share one.
+void FairingWindow::predict_next(Channel& ch, std::span<const Vec3> zeta) {
+  PredictionCheck::State& s = ch.check.state();
+  s.predicted = n_ == w_ && zeta.size() == static_cast<std::size_t>(w_ - 1) && !ch.estimator.at_rest();
+  if (!s.predicted) return;
+  for (std::size_t j = 0; j < s.prediction.size(); ++j) {
+    const double level = ch.candidate_level[j];
+    if (j > 0 && level == ch.candidate_level[j - 1]) {
+      s.prediction[j] = s.prediction[j - 1];
+      continue;
+    }
+    const int i = static_cast<int>(level);
+    const double f = level - i;
+    const EmissionRow& a = next_rows_[static_cast<std::size_t>(i)];
+    const EmissionRow& b = i + 1 < level_count_ ? next_rows_[static_cast<std::size_t>(i + 1)] : a;
+    const double g = 1.0 - f;
+    s.prediction[j] = weighted_vector_sum(
+        std::min(a.first, b.first), n_ - 1,
+        [&](int q) { return g * a.zeta[static_cast<std::size_t>(q)] + f * b.zeta[static_cast<std::size_t>(q)]; }, zeta);
+  }
 }
 
 namespace {
@@ -471,6 +561,7 @@ EngineState FairingWindow::state() const {
       out.at_rest = estimator.at_rest();
       out.motion = dt > 0.0 ? unit * std::sqrt(3.0 * estimator.motion_variance()) / std::pow(dt, config_.order) : 0.0;
       out.rest_averaged = ch.rest.averaged;
+      if (checks_prediction(ch)) out.noise_scale = ch.check.scale();
     }
   }
   return s;
@@ -668,6 +759,8 @@ std::size_t FairingWindow::memory_bytes() const {
   auto row_bytes = [](const EmissionRow& r) { return (r.zeta.capacity() + r.c.capacity()) * sizeof(double); };
   bytes += levels_.capacity() * sizeof(EmissionRow) + level_tail_bias_.capacity() * sizeof(double);
   for (const EmissionRow& r : levels_) bytes += row_bytes(r);
+  bytes += next_rows_.capacity() * sizeof(EmissionRow);
+  for (const EmissionRow& r : next_rows_) bytes += row_bytes(r);
   bytes += row_bytes(fill_row_) + row_bytes(rot_.fixed) + row_bytes(pos_.fixed);
   // The builder's band matrix and scratch, and the three estimators' fit, half-span fit, window
   // fit and line weights.
@@ -756,6 +849,7 @@ int FairingWindow::start_afresh(std::span<FairedPose> out) {
     ch->rest = Channel::Rest{};
     ch->mu = 0.0;
     ch->level = 0.0;
+    ch->check.restart();
   }
   rest_chart_ready_ = false;
   rot_guard_ = OutlierGuard(outlier_threshold(config_), 0.5);
@@ -941,6 +1035,8 @@ void FairingWindow::restore(Channel& ch, const Learnt& l) {
   ch.mu = l.mu;
   ch.level = l.level;
   ch.rest = l.rest;
+  ch.check.state() = l.check;
+  ch.candidate_level = l.candidate_level;
 }
 
 void FairingWindow::slide(int count) {

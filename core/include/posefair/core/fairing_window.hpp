@@ -33,6 +33,7 @@
 #include "posefair/core/fairing_operators.hpp"
 #include "posefair/core/gyro_aiding.hpp"
 #include "posefair/core/outlier_guard.hpp"
+#include "posefair/core/prediction_check.hpp"
 #include "posefair/core/repeated_measurements.hpp"
 #include "posefair/core/rest_line.hpp"
 #include "posefair/core/sample.hpp"
@@ -135,6 +136,9 @@ struct ChannelAdaptation {
   double cutoff_hz = 0.0;  // the cutoff μ corresponds to at the rate (0 while the rate is unknown)
   bool at_rest = false;    // adapted: the stream is still, and smoothed as hard as the window allows (smoothing_adaptation.hpp)
   bool rest_averaged = false;  // at rest and averaged over seconds, not the window (rest_line.hpp)
+  // adapted at lag 0: the factor on the noise variance that the check by the next measurement
+  // took (prediction_check.hpp); 1 where the noise estimate stands
+  double noise_scale = 1.0;
 };
 struct EngineState {
   double rate_hz = 0.0;    // given or measured; 0 until known (the source's while repeating)
@@ -195,6 +199,10 @@ class FairingWindow {
       // go out as measured while the level's correction stands over the noise (linear_emission_estimate).
       int leaving = 0;
     } rest;
+    // The noise estimate checked by the next measurement (prediction_check.hpp): its candidates'
+    // levels, chosen with the noise scaled by PredictionCheck::scale(j).
+    PredictionCheck check;
+    std::array<double, PredictionCheck::kCandidates> candidate_level{};
   };
   // What a channel's adaptation had learnt before a held sample went in: put back when the next
   // sample releases it, and the released sample learnt from as measured, so that a released
@@ -203,8 +211,12 @@ class FairingWindow {
     MotionNoiseEstimator::Estimates estimates;
     double mu = 0.0, level = 0.0;
     Channel::Rest rest;
+    PredictionCheck::State check;
+    std::array<double, PredictionCheck::kCandidates> candidate_level{};
   };
-  static Learnt learnt(const Channel& ch) { return {ch.estimator.estimates(), ch.mu, ch.level, ch.rest}; }
+  static Learnt learnt(const Channel& ch) {
+    return {ch.estimator.estimates(), ch.mu, ch.level, ch.rest, ch.check.state(), ch.candidate_level};
+  }
   static void restore(Channel& ch, const Learnt& l);
 
   // held_'s bits: which channel of a sample holds the prediction.
@@ -222,6 +234,9 @@ class FairingWindow {
   void prepare(double rate_hz);
   void slide(int count);
   void adapt(Channel& ch, std::span<const Vec3> zeta, double dt);
+  bool checks_prediction(const Channel& ch) const;
+  void compare_predictions(Channel& ch, std::span<const Vec3> zeta);
+  void predict_next(Channel& ch, std::span<const Vec3> zeta);
   std::span<const Vec3> rest_increments(int count);
   enum class Departure { None, Off, Moving };
   Departure departs_from_rest(Channel& ch);
@@ -299,6 +314,7 @@ class FairingWindow {
   // Linear solver.
   EmissionTarget target_spec_;
   EmissionRowBuilder builder_;
+  std::vector<EmissionRow> next_rows_;  // the levels' predictions of the next sample (checks_prediction)
   std::vector<EmissionRow> levels_;  // candidate rows for the adaptation, least smoothing first
   std::array<double, kMaxSmoothingLevels> level_shared_gain_{};  // [l]: shared_noise_gain of levels l, l + 1
   int level_count_ = 0;

@@ -67,6 +67,9 @@ struct AdaptationSettings {
   // (rest_line.hpp): a still pose averaged over seconds, not the window's half second.
   // 0: the window's heaviest smoothing at rest.
   double rest_memory_s = 1.0;
+  // At lag 0, the noise estimate is checked by how well smoothings predict the next measurement,
+  // and scaled down where a lighter one predicts it better (prediction_check.hpp).
+  bool prediction_check = true;
 };
 
 // A difference D^kθ the noise estimate reads: its weights on the newest k differences ζ, and

@@ -1,0 +1,75 @@
+#pragma once
+// The noise estimate checked against the stream's next measurement.
+//
+// The adaptation reads the noise from the stream's highest differences (smoothing_adaptation.hpp).
+// A motion that fills them as noise does (a walk's wandering rate, a shake near Nyquist, a clean
+// tracker's quick turns) reads as noise, and the level chosen then smooths real motion: a clean
+// walk at 10 Hz had 6.4 times raw's error (docs/engine.md, "Checked by the next measurement").
+// What the stream does show, whatever its noise, is how well a smoothing predicts the next
+// measurement: the squared error of a prediction made from the samples before is the next sample's
+// noise σ² (the same for every predictor, since that noise is independent of the past) plus the
+// prediction's own error. So of two smoothings, the one that predicts the next measurement better
+// is the better estimate of the motion, with no need to know σ² (the prediction error method of
+// system identification).
+//
+// Candidates: the noise estimate scaled by kScaleStep^j, j = 0 … kCandidates − 1, each choosing its
+// level as the adaptation does. For each sample the window predicts the next measurement with each
+// candidate's level (rows one sample ahead); here the squared errors are averaged over kTime, and
+// a candidate is taken where its mean error is below the unscaled one's by more than kSignificance
+// standard errors (of the paired difference, sample by sample). Taken, it stays while it is still
+// below on average. Only downward: white noise fills the highest differences whatever else does,
+// so they do not read less noise than there is.
+// Small and copyable (the window puts it back with the adaptation after a held sample).
+#include <array>
+#include <span>
+
+#include "posefair/core/so3.hpp"
+
+namespace posefair {
+
+class PredictionCheck {
+ public:
+  static constexpr int kCandidates = 6;
+  static constexpr double kScaleStep = 0.25;  // down to 1/1024 of the noise variance: a 32nd of σ
+  // The errors' averaging time. At 2 s a still stream's and quick turns' choice wandered more
+  // (`posefair bench streams`, 2026-12-06: the same gains, one loss more); 4 s is 40 samples at 10 Hz.
+  static constexpr double kTime = 4.0;
+  static constexpr double kSignificance = 2.0;
+  static constexpr int kMinSamples = 8;  // compared errors before a candidate can be taken
+  // Predictions made and compared per second, at most: at 1 kHz every 10th sample (400 in the
+  // average over kTime), a third of the cost of every refresh of the levels.
+  static constexpr double kChecksPerSecond = 100.0;
+
+  // The noise variance's factor of candidate j.
+  static double scale(int j);
+
+  // evaluations_per_second: how often note() is called on a steady stream (the rate, or less).
+  void configure(double evaluations_per_second);
+  // The squared errors of each candidate's prediction of the newest measurement, candidate 0's
+  // first (per component).
+  void note(std::span<const double, kCandidates> squared_errors);
+  // Forgets what it has compared (a new stream).
+  void restart();
+
+  int choice() const { return s_.choice; }
+  double scale() const { return scale(s_.choice); }
+
+  // The predictions the window made for the next measurement, kept with what was compared.
+  struct State {
+    std::array<double, kCandidates> mean{};         // of (error_j − error_0)
+    std::array<double, kCandidates> mean_square{};  // of (error_j − error_0)²
+    double count = 0.0;                              // comparisons made (while under the averaging's length)
+    int choice = 0;
+    std::array<Vec3, kCandidates> prediction{};
+    bool predicted = false;  // prediction holds one for the next sample
+    double since_check_s = 0.0;  // stream time since the last predictions were made
+  };
+  State& state() { return s_; }
+  const State& state() const { return s_; }
+
+ private:
+  double alpha_ = 0.0;  // the average's weight for one comparison
+  State s_;
+};
+
+}  // namespace posefair

@@ -1,0 +1,39 @@
+#include "posefair/core/prediction_check.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace posefair {
+
+double PredictionCheck::scale(int j) { return std::pow(kScaleStep, j); }
+
+void PredictionCheck::configure(double evaluations_per_second) {
+  alpha_ = evaluations_per_second > 0.0 ? 1.0 - std::exp(-1.0 / (kTime * evaluations_per_second)) : 1.0;
+}
+
+void PredictionCheck::restart() { s_ = State{}; }
+
+void PredictionCheck::note(std::span<const double, kCandidates> squared_errors) {
+  // An exact mean over the first comparisons, then exponentially over kTime.
+  s_.count = std::min(s_.count + 1.0, 1.0 / alpha_);
+  const double a = std::max(1.0 / s_.count, alpha_);
+  // The variance of such a mean per unit variance: 1/count, then a/(2 − a).
+  const double spread = a > alpha_ ? a : a / (2.0 - a);
+  int best = 0;
+  double best_mean = 0.0;
+  for (std::size_t j = 1; j < kCandidates; ++j) {
+    const double d = squared_errors[j] - squared_errors[0];
+    s_.mean[j] += a * (d - s_.mean[j]);
+    s_.mean_square[j] += a * (d * d - s_.mean_square[j]);
+    const double variance = std::max(0.0, s_.mean_square[j] - s_.mean[j] * s_.mean[j]);
+    if (s_.count >= kMinSamples && s_.mean[j] < best_mean && s_.mean[j] < -kSignificance * std::sqrt(variance * spread)) {
+      best = static_cast<int>(j);
+      best_mean = s_.mean[j];
+    }
+  }
+  // A candidate taken stays while it still predicts better on average.
+  if (best == 0 && s_.choice > 0 && s_.mean[static_cast<std::size_t>(s_.choice)] < 0.0) best = s_.choice;
+  s_.choice = best;
+}
+
+}  // namespace posefair
