@@ -107,8 +107,10 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
                 c.bound == BoundPolicy::Sample ? "sample" : "window");
     auto channel = [&](const char* name, const ChannelAdaptation& a, const char* unit) {
       if (a.adaptive)
-        std::printf("%s adapted: noise %.3g %s, motion %.3g %s/s^%d, mu %.4g (cutoff %.3g Hz)%s at the end\n", name, a.noise,
-                    unit, a.motion, unit, c.order, a.smoothing, a.cutoff_hz, a.rest_averaged ? ", at rest, averaged over seconds," : a.at_rest ? ", at rest," : "");
+        std::printf("%s adapted: noise %.3g %s, motion %.3g %s/s^%d, mu %.4g (cutoff %.3g Hz)%s%s at the end\n", name, a.noise,
+                    unit, a.motion, unit, c.order, a.smoothing, a.cutoff_hz,
+                    a.noise_scale < 1.0 ? (", chosen for noise^2/" + std::to_string(std::lround(1.0 / a.noise_scale)) + " (predicted)").c_str() : "",
+                    a.rest_averaged ? ", at rest, averaged over seconds," : a.at_rest ? ", at rest," : "");
       else
         std::printf("%s fixed: mu %.6g (cutoff %.3g Hz)\n", name, a.smoothing, a.cutoff_hz);
     };

@@ -31,7 +31,8 @@ void PredictionCheck::note(std::span<const double, kCandidates> squared_errors) 
       best_mean = s_.mean[j];
     }
   }
-  // A candidate taken stays while it still predicts better on average.
+  // A candidate taken stays while it still predicts better on average: where two candidates
+  // predict alike, either will do.
   if (best == 0 && s_.choice > 0 && s_.mean[static_cast<std::size_t>(s_.choice)] < 0.0) best = s_.choice;
   s_.choice = best;
 }

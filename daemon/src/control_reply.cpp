@@ -38,6 +38,7 @@ std::string channel(const ChannelAdaptation& c) {
       .number("cutoff_hz", c.cutoff_hz)
       .add("at_rest", c.at_rest)
       .add("rest_averaged", c.rest_averaged)
+      .number("noise_scale", c.noise_scale)
       .str();
 }
 

@@ -93,6 +93,7 @@ void store_engine_state(StreamCounters& c, const EngineState& e) {
     to.cutoff_hz.store(from.cutoff_hz, relaxed);
     to.at_rest.store(from.at_rest, relaxed);
     to.rest_averaged.store(from.rest_averaged, relaxed);
+    to.noise_scale.store(from.noise_scale, relaxed);
   }
   c.gyro.active.store(e.gyro.active, relaxed);
   c.gyro.offset_estimated.store(e.gyro.offset_estimated, relaxed);
@@ -119,6 +120,7 @@ EngineState load_engine_state(const StreamCounters& c) {
     to.cutoff_hz = from.cutoff_hz.load(relaxed);
     to.at_rest = from.at_rest.load(relaxed);
     to.rest_averaged = from.rest_averaged.load(relaxed);
+    to.noise_scale = from.noise_scale.load(relaxed);
   }
   e.gyro.active = c.gyro.active.load(relaxed);
   e.gyro.offset_estimated = c.gyro.offset_estimated.load(relaxed);

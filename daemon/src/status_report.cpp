@@ -60,6 +60,15 @@ const char* rest_text(const ChannelAdaptation& a) {
   return a.rest_averaged ? ", at rest, averaged over seconds" : a.at_rest ? ", at rest" : "";
 }
 
+// The noise the level is chosen for, where the check by the next measurement took less than the
+// estimate (docs/engine.md, "Checked by the next measurement"): " (chosen for noise/1024, predicted)".
+std::string scale_text(const ChannelAdaptation& a) {
+  if (!(a.noise_scale < 1.0)) return {};
+  char buf[64];
+  std::snprintf(buf, sizeof buf, " (chosen for noise^2/%.4g, predicted)", 1.0 / a.noise_scale);
+  return buf;
+}
+
 // "; engine 285.7 Hz, window 128, rotation adapted: noise 0.0012 rad, motion 3.1 rad/s^2,
 //  cutoff 8.2 Hz (mu 352)" — the adaptation's measurements and choice, or the fixed smoothing.
 std::string engine_text(const EngineState& e, const std::optional<GyroPairingStats>& pairing, std::uint64_t gyro_bridged) {
@@ -72,8 +81,8 @@ std::string engine_text(const EngineState& e, const std::optional<GyroPairingSta
   text += buf;
   auto channel = [&](const char* name, const ChannelAdaptation& a, const char* unit) {
     if (a.adaptive)
-      std::snprintf(buf, sizeof buf, ", %s adapted: noise %.3g %s, motion %.3g %s/s^m, cutoff %.3g Hz (mu %.4g)%s", name,
-                    a.noise, unit, a.motion, unit, a.cutoff_hz, a.smoothing, rest_text(a));
+      std::snprintf(buf, sizeof buf, ", %s adapted: noise %.3g %s, motion %.3g %s/s^m, cutoff %.3g Hz (mu %.4g)%s%s", name,
+                    a.noise, unit, a.motion, unit, a.cutoff_hz, a.smoothing, scale_text(a).c_str(), rest_text(a));
     else
       std::snprintf(buf, sizeof buf, ", %s fixed: cutoff %.3g Hz (mu %.4g)", name, a.cutoff_hz, a.smoothing);
     text += buf;
@@ -181,7 +190,12 @@ std::string status_line(const std::vector<StreamStats>& now, const std::vector<S
     // What the smoothing is doing: its cutoff now (adapted or fixed), once the rate is known.
     if (s.engine.rate_hz > 0.0) {
       const ChannelAdaptation& r = s.engine.rotation;
-      std::snprintf(buf, sizeof buf, " fc %.3gHz%s", r.cutoff_hz, !r.adaptive ? "" : r.rest_averaged ? " (adapted, at rest, averaged)" : r.at_rest ? " (adapted, at rest)" : " (adapted)");
+      std::snprintf(buf, sizeof buf, " fc %.3gHz%s", r.cutoff_hz,
+                    !r.adaptive              ? ""
+                    : r.rest_averaged        ? " (adapted, at rest, averaged)"
+                    : r.at_rest              ? " (adapted, at rest)"
+                    : r.noise_scale < 1.0    ? " (adapted, predicted)"
+                                             : " (adapted)");
       out += buf;
       if (s.engine.repeating) {
         std::snprintf(buf, sizeof buf, " source %.3gHz (repeated)", s.engine.rate_hz);

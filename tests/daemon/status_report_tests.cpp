@@ -227,14 +227,22 @@ TEST(StatusReport, CounterLineAndStatusCarryTheEngineAdaptation) {
             std::string::npos)
       << still[0];
   EXPECT_NE(status_line({s}, {}, 1.0).find(" fc 0.11Hz (adapted, at rest)"), std::string::npos) << status_line({s}, {}, 1.0);
-  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("cutoff_hz":0.11,"at_rest":true,"rest_averaged":false})"), std::string::npos)
+  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("cutoff_hz":0.11,"at_rest":true,"rest_averaged":false,"noise_scale":1})"), std::string::npos)
       << streams_member({s}, {}, 1.0);
   // Averaged over seconds by the rest line (docs/engine.md, "At rest"): said in all three.
   s.engine.rotation.rest_averaged = true;
   const auto averaged = counter_lines({s}, {}, 0.0);
   EXPECT_NE(averaged[0].find("cutoff 0.11 Hz (mu 1e+09), at rest, averaged over seconds"), std::string::npos) << averaged[0];
   EXPECT_NE(status_line({s}, {}, 1.0).find(" fc 0.11Hz (adapted, at rest, averaged)"), std::string::npos) << status_line({s}, {}, 1.0);
-  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("at_rest":true,"rest_averaged":true})"), std::string::npos) << streams_member({s}, {}, 1.0);
+  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("at_rest":true,"rest_averaged":true,"noise_scale":1})"), std::string::npos) << streams_member({s}, {}, 1.0);
+  // Moving, with the level chosen for less noise than the estimate: a lighter smoothing predicted
+  // the next measurement better (docs/engine.md, "Checked by the next measurement").
+  s.engine.rotation = ChannelAdaptation{true, 0.0012, 3.1, 0.5, 40.0};
+  s.engine.rotation.noise_scale = 1.0 / 64.0;
+  const auto predicted = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(predicted[0].find("cutoff 40 Hz (mu 0.5) (chosen for noise^2/64, predicted)"), std::string::npos) << predicted[0];
+  EXPECT_NE(status_line({s}, {}, 1.0).find(" fc 40Hz (adapted, predicted)"), std::string::npos) << status_line({s}, {}, 1.0);
+  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("noise_scale":0.015625})"), std::string::npos) << streams_member({s}, {}, 1.0);
 }
 
 TEST(StatusReport, AFusionStageAddsItsBiasRestDisturbanceAndCounters) {
