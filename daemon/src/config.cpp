@@ -139,7 +139,7 @@ constexpr std::string_view kDaemonKeys[] = {"exit_when_sources_end", "session_id
 constexpr std::string_view kLoggingKeys[] = {"level", "target", "status_interval"};
 constexpr std::string_view kEngineKeys[] = {
     "window",   "window_time", "max_window", "lag", "horizon", "order", "solver", "iterations", "smoothing", "smoothing_r",
-    "smoothing_t", "cutoff_hz", "rate_hz", "noise_time", "motion_time", "motion_span", "motion_margin", "rest_threshold", "rest_memory", "continuity",
+    "smoothing_t", "cutoff_hz", "rate_hz", "noise_time", "motion_time", "motion_span", "motion_margin", "rest_threshold", "rest_memory", "prediction_check", "continuity",
     "lambda_r", "lambda_t", "variant",
     "epsilon_r", "epsilon_t", "bound",  "gap",       "gap_intervals", "unit_tolerance", "outlier_threshold", "gyro_aided", "gyro_time_offset",
     "gyro_estimate_offset", "gyro_mounting", "gyro_stream"};
@@ -333,6 +333,7 @@ struct EngineLayer {
   std::optional<Given<BoundPolicy>> bound;
   // Gyro-aided fairing (core/gyro_aiding.hpp).
   std::optional<Given<bool>> gyro_aided, gyro_estimate_offset;
+  std::optional<Given<bool>> prediction_check;  // the adaptation's check by the next measurement
   std::optional<Given<double>> gyro_time_offset;
   std::optional<Given<Quat>> gyro_mounting;
   std::optional<Given<std::string>> gyro_stream;  // [stream.engine] only: the stream whose gyroscope this one gets
@@ -610,7 +611,8 @@ class Parser {
     real("gap_intervals", e.gap_intervals, kNonNegative);
     real("unit_tolerance", e.unit_tolerance, FloatRange{0.0, true, 1.0, true});
     real("outlier_threshold", e.outlier_threshold, FloatRange{0.0, false, kMaxOutlierThreshold, false});
-    for (auto [name, field] : {std::pair{"gyro_aided", &e.gyro_aided}, std::pair{"gyro_estimate_offset", &e.gyro_estimate_offset}})
+    for (auto [name, field] : {std::pair{"gyro_aided", &e.gyro_aided}, std::pair{"gyro_estimate_offset", &e.gyro_estimate_offset},
+                               std::pair{"prediction_check", &e.prediction_check}})
       if (const toml::node* n = t.get(name)) {
         const std::string key = join_key(prefix, name);
         *field = Given<bool>{get_bool(*n, key), where(*n, key)};
@@ -686,6 +688,7 @@ class Parser {
       take(layer->motion_margin, c.adaptation.motion_margin, EngineSetting::Adaptation);
       take(layer->rest_threshold, c.adaptation.rest_threshold, EngineSetting::Adaptation);
       take(layer->rest_memory, c.adaptation.rest_memory_s, EngineSetting::Adaptation);
+      if (layer->prediction_check) c.adaptation.prediction_check = layer->prediction_check->value;
       if (layer->gyro_aided) c.gyro.enabled = layer->gyro_aided->value;
       if (layer->gyro_estimate_offset) c.gyro.estimate_time_offset = layer->gyro_estimate_offset->value;
       if (layer->gyro_time_offset) c.gyro.time_offset_s = layer->gyro_time_offset->value;

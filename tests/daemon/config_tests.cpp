@@ -94,6 +94,7 @@ motion_span = 0.5
 motion_margin = 3
 rest_threshold = 3          # 0: never at rest
 rest_memory = 2.5           # s; 0: the window's smoothing at rest
+prediction_check = false    # the noise estimate as it reads, unchecked
 outlier_threshold = 10      # multiples of the median distance from the prediction; 0: off
 
 [[stream]]
@@ -227,6 +228,7 @@ TEST(Config, AFullConfigFillsEveryField) {
     EXPECT_EQ(e.adaptation.motion_margin, 1.5);
     EXPECT_EQ(e.adaptation.rest_threshold, 3.0);
     EXPECT_EQ(e.adaptation.rest_memory_s, 2.5);
+    EXPECT_FALSE(e.adaptation.prediction_check);
     EXPECT_EQ(e.outlier_threshold, 10.0);
   }
   {
@@ -1415,6 +1417,12 @@ name = "a"
 driver = { type = "synthetic", rate_hz = 100 }
 engine = { gyro_estimate_offset = 1 }
 )", "stream[1].engine.gyro_estimate_offset: expected a boolean, got an integer", 5},
+    {"prediction_check not a boolean", R"([[stream]]
+id = 1
+name = "a"
+driver = { type = "synthetic", rate_hz = 100 }
+engine = { prediction_check = "off" }
+)", "stream[1].engine.prediction_check: expected a boolean, got a string", 5},
     {"gyro_time_offset out of range", R"([engine]
 gyro_time_offset = 0.2
 [[stream]]
