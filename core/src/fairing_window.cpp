@@ -354,7 +354,10 @@ void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
     return;
   }
   const bool checked = checks_prediction(ch);
-  if (checked) compare_predictions(ch, zeta);
+  if (checked) {
+    compare_predictions(ch, zeta);
+    ch.check.state().since_check_s += dt;
+  }
   if (!refreshed) return;  // the level follows the motion estimate's refreshes
   // A motion that stopped and is still in the window: each level's drag towards it counts too.
   const MotionNoiseEstimator::StoppedMotion stopped = estimator.stopped_motion(w_);
@@ -375,7 +378,6 @@ void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
     // same at rest (no motion: the heaviest for any noise), and pass-through once one is (less
     // noise only lightens).
     PredictionCheck::State& s = ch.check.state();
-    s.since_check_s += dt;
     const double period = 1.0 / PredictionCheck::kChecksPerSecond;
     const bool check = s.since_check_s >= (1.0 - 1e-9) * period;
     ch.candidate_level[0] = ch.level;
