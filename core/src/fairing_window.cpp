@@ -1,7 +1,6 @@
 #include "posefair/core/fairing_window.hpp"
 
 #include <algorithm>
-#include <cstdlib>
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
@@ -428,29 +427,6 @@ void FairingWindow::compare_predictions(Channel& ch, std::span<const Vec3> zeta)
   ch.check.note(errors);
 }
 
-// Each candidate's prediction of the next measurement, as an increment from the newest (a full
-// window, not at rest). Candidates at the same level share one.
-void FairingWindow::predict_next(Channel& ch, std::span<const Vec3> zeta) {
-  PredictionCheck::State& s = ch.check.state();
-  s.predicted = n_ == w_ && zeta.size() == static_cast<std::size_t>(w_ - 1) && !ch.estimator.at_rest();
-  if (!s.predicted) return;
-  for (std::size_t j = 0; j < s.prediction.size(); ++j) {
-    const double level = ch.candidate_level[j];
-    if (j > 0 && level == ch.candidate_level[j - 1]) {
-      s.prediction[j] = s.prediction[j - 1];
-      continue;
-    }
-    const int i = static_cast<int>(level);
-    const double f = level - i;
-    const EmissionRow& a = next_rows_[static_cast<std::size_t>(i)];
-    const EmissionRow& b = i + 1 < level_count_ ? next_rows_[static_cast<std::size_t>(i + 1)] : a;
-    const double g = 1.0 - f;
-    s.prediction[j] = weighted_vector_sum(
-        std::min(a.first, b.first), n_ - 1,
-        [&](int q) { return g * a.zeta[static_cast<std::size_t>(q)] + f * b.zeta[static_cast<std::size_t>(q)]; }, zeta);
-  }
-}
-
 namespace {
 
 // u = Σ_j row.zeta_j ζ_j (+ Σ_i row.c_i c_i over emitted samples).
@@ -470,6 +446,24 @@ Vec3 apply_rows(const EmissionRow& a, const EmissionRow& b, double f, int n, std
 }
 
 }  // namespace
+
+// Each candidate's prediction of the next measurement, as an increment from the newest (a full
+// window, not at rest). Candidates at the same level share one.
+void FairingWindow::predict_next(Channel& ch, std::span<const Vec3> zeta) {
+  PredictionCheck::State& s = ch.check.state();
+  s.predicted = n_ == w_ && zeta.size() == static_cast<std::size_t>(w_ - 1) && !ch.estimator.at_rest();
+  if (!s.predicted) return;
+  for (std::size_t j = 0; j < s.prediction.size(); ++j) {
+    const double level = ch.candidate_level[j];
+    if (j > 0 && level == ch.candidate_level[j - 1]) {
+      s.prediction[j] = s.prediction[j - 1];
+      continue;
+    }
+    const int i = static_cast<int>(level);
+    const EmissionRow& a = next_rows_[static_cast<std::size_t>(i)];
+    s.prediction[j] = apply_rows(a, i + 1 < level_count_ ? next_rows_[static_cast<std::size_t>(i + 1)] : a, level - i, n_, zeta);
+  }
+}
 
 // The level in use's two rows and the blend between them (f: the second's share).
 FairingWindow::LevelRows FairingWindow::level_rows(const Channel& ch) const {
