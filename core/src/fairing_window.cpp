@@ -353,6 +353,7 @@ void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
     return;
   }
   const bool checked = checks_prediction(ch);
+  if (checked && estimator.at_rest()) ch.check.note_rest();
   if (checked) {
     compare_predictions(ch, zeta);
     ch.check.state().since_check_s += dt;

@@ -31,6 +31,16 @@ void PredictionCheck::note(std::span<const double, kCandidates> squared_errors) 
       best_mean = s_.mean[j];
     }
   }
+  if (!s_.weighed) {
+    constexpr auto l = static_cast<std::size_t>(kCandidates - 1);
+    const double variance = std::max(0.0, s_.mean_square[l] - s_.mean[l] * s_.mean[l]);
+    if (s_.count >= kMinSamples) {
+      s_.weighed = true;
+      if (best == 0) s_.choice = kCandidates - 1;  // and stays while it predicts better (below)
+    } else if (s_.count >= kFirstSpread && s_.mean[l] > kSignificance * std::sqrt(variance * spread)) {
+      s_.weighed = true;
+    }
+  }
   // A candidate taken stays while it still predicts better on average: where two candidates
   // predict alike, either will do.
   if (best == 0 && s_.choice > 0 && s_.mean[static_cast<std::size_t>(s_.choice)] < 0.0) best = s_.choice;

@@ -19,6 +19,12 @@
 // standard errors (of the paired difference, sample by sample). Taken, it stays while it is still
 // below on average. Only downward: white noise fills the highest differences whatever else does,
 // so they do not read less noise than there is.
+// Until it has evidence the lightest candidate goes out: a noise estimate no comparison has
+// weighed may be motion (a clean walk at 10 Hz was smoothed to 6 times raw's error for the 1–2 s
+// the first comparisons took), and passing the measurements through is never far from them. The
+// evidence: kMinSamples comparisons (then the lightest stays while it predicts better on average),
+// the lightest predicting worse by kSignificance standard errors (from kFirstSpread comparisons
+// on), or a rest, where the highest differences hold the noise alone (note_rest).
 // Small and copyable (the window puts it back with the adaptation after a held sample).
 #include <array>
 #include <span>
@@ -36,6 +42,7 @@ class PredictionCheck {
   static constexpr double kTime = 4.0;
   static constexpr double kSignificance = 2.0;
   static constexpr int kMinSamples = 8;  // compared errors before a candidate can be taken
+  static constexpr int kFirstSpread = 3;  // compared errors before the lightest can be let go as worse
   // Predictions made and compared per second, at most: at 1 kHz every 10th sample (400 in the
   // average over kTime), a third of the cost of every refresh of the levels.
   static constexpr double kChecksPerSecond = 100.0;
@@ -48,11 +55,13 @@ class PredictionCheck {
   // The squared errors of each candidate's prediction of the newest measurement, candidate 0's
   // first (per component).
   void note(std::span<const double, kCandidates> squared_errors);
+  // The stream is at rest: its noise estimate is the noise alone.
+  void note_rest() { s_.weighed = true; }
   // Forgets what it has compared (a new stream).
   void restart();
 
-  int choice() const { return s_.choice; }
-  double scale() const { return scale(s_.choice); }
+  int choice() const { return s_.weighed ? s_.choice : kCandidates - 1; }
+  double scale() const { return scale(choice()); }
 
   // The predictions the window made for the next measurement, kept with what was compared.
   struct State {
@@ -63,6 +72,7 @@ class PredictionCheck {
     std::array<Vec3, kCandidates> prediction{};
     bool predicted = false;  // prediction holds one for the next sample
     double since_check_s = 0.0;  // stream time since the last predictions were made
+    bool weighed = false;    // the noise estimate has evidence (before it, the lightest goes out)
   };
   State& state() { return s_; }
   const State& state() const { return s_; }
