@@ -319,8 +319,12 @@ void FairingWindow::prepare(double rate_hz) {
         // at most PredictionCheck::kChecksPerSecond times a second.
         const double evaluations = std::min({rate_hz, MotionNoiseEstimator::kMotionRefreshes / config_.adaptation.motion_time_s,
                                              PredictionCheck::kChecksPerSecond});
-        rot_.check.configure(evaluations);
-        pos_.check.configure(evaluations);
+        // With a horizon the lightest candidate dead-reckons the measurements, noise and all: the
+        // estimate is used from the start (the quality benchmark's 100 Hz set under noise 0.05 at
+        // 20 ms lost 2.9% with the lightest first).
+        const bool lightest_first = config_.horizon_s == 0.0;
+        rot_.check.configure(evaluations, lightest_first);
+        pos_.check.configure(evaluations, lightest_first);
       }
       const int k = w_ - 1 - config_.lag;  // the emitted sample
       for (int l = 0; l + 1 < level_count_; ++l)

@@ -7,11 +7,16 @@ namespace posefair {
 
 double PredictionCheck::scale(int j) { return std::pow(kScaleStep, j); }
 
-void PredictionCheck::configure(double evaluations_per_second) {
+void PredictionCheck::configure(double evaluations_per_second, bool lightest_first) {
   alpha_ = evaluations_per_second > 0.0 ? 1.0 - std::exp(-1.0 / (kTime * evaluations_per_second)) : 1.0;
+  lightest_first_ = lightest_first;
+  if (!lightest_first_) s_.weighed = true;
 }
 
-void PredictionCheck::restart() { s_ = State{}; }
+void PredictionCheck::restart() {
+  s_ = State{};
+  s_.weighed = !lightest_first_;
+}
 
 void PredictionCheck::note(std::span<const double, kCandidates> squared_errors) {
   // An exact mean over the first comparisons, then exponentially over kTime.

@@ -32,7 +32,7 @@ Errors candidate_errors(std::mt19937_64& rng, const Errors& gain) {
 
 TEST(PredictionCheck, ACandidateThatPredictsBetterIsTakenOnceItIsSignificant) {
   PredictionCheck check;
-  check.configure(100.0);
+  check.configure(100.0, true);
   std::mt19937_64 rng(1);
   // Candidate 3 predicts 30% better, the others as candidate 0.
   const Errors gain{0.0, 0.0, 0.0, -0.3, 0.0, 0.0};
@@ -51,7 +51,7 @@ TEST(PredictionCheck, CandidatesThatPredictWorseAreNotTaken) {
   // stands nearly all the time. (Candidates that predict exactly alike are taken by chance now and
   // then, and kept while their mean is below; either does as well.)
   PredictionCheck check;
-  check.configure(100.0);
+  check.configure(100.0, true);
   std::mt19937_64 rng(2);
   int taken = 0;
   const int n = 40000;
@@ -64,7 +64,7 @@ TEST(PredictionCheck, CandidatesThatPredictWorseAreNotTaken) {
 
 TEST(PredictionCheck, ACandidateTakenIsLetGoWhenItPredictsWorse) {
   PredictionCheck check;
-  check.configure(100.0);
+  check.configure(100.0, true);
   std::mt19937_64 rng(3);
   for (int i = 0; i < 400; ++i) check.note(candidate_errors(rng, Errors{0.0, -0.4, 0.0, 0.0, 0.0, 0.0}));
   ASSERT_EQ(check.choice(), 1);
@@ -83,7 +83,7 @@ TEST(PredictionCheck, TheLightestGoesOutUntilTheEstimateIsWeighed) {
     // Candidates alike: the lightest until kMinSamples comparisons, then it stays while its mean
     // is below the unscaled one's, and is let go when the motion makes it predict worse.
     PredictionCheck check;
-    check.configure(100.0);
+    check.configure(100.0, true);
     EXPECT_EQ(check.choice(), lightest);
     std::mt19937_64 rng(4);
     for (int i = 0; i < PredictionCheck::kMinSamples; ++i) check.note(candidate_errors(rng, Errors{}));
@@ -95,7 +95,7 @@ TEST(PredictionCheck, TheLightestGoesOutUntilTheEstimateIsWeighed) {
   {
     // The lightest predicting clearly worse (a noisy stream): let go after kFirstSpread comparisons.
     PredictionCheck check;
-    check.configure(100.0);
+    check.configure(100.0, true);
     std::mt19937_64 rng(5);
     int comparisons = 0;
     while (check.choice() == lightest && comparisons < 100) {
@@ -110,6 +110,14 @@ TEST(PredictionCheck, TheLightestGoesOutUntilTheEstimateIsWeighed) {
     // A rest: the noise estimate is the noise alone.
     PredictionCheck check;
     check.note_rest();
+    EXPECT_EQ(check.choice(), 0);
+  }
+  {
+    // Not lightest first (a horizon): the estimate from the start, and again after a restart.
+    PredictionCheck check;
+    check.configure(100.0, false);
+    EXPECT_EQ(check.choice(), 0);
+    check.restart();
     EXPECT_EQ(check.choice(), 0);
   }
 }
@@ -200,6 +208,17 @@ TEST(PredictionCheckInTheEngine, AStreamsFirstSecondsAreNotSmoothedBeforeTheyAre
     const WalkScore n_with = score_walk(WindowConfig{}, noisy, 1.5), n_without = score_walk(off, noisy, 1.5);
     EXPECT_NEAR(n_with.error, n_without.error, 0.02 * n_without.error);
   }
+}
+
+TEST(PredictionCheckInTheEngine, WithAHorizonTheEstimateIsUsedFromTheStart) {
+  // Passing through with a horizon is dead reckoning, which carries the noise forward: the first
+  // comparisons are made with the estimate in use. A walk at 10 Hz after 1 s (a full window of 8
+  // and two comparisons, too few to weigh anything).
+  const Walk s = wandering_walk(10.0, 1.05, 0.0002, 1);
+  WindowConfig predicting;
+  predicting.horizon_s = 0.02;
+  EXPECT_EQ(score_walk(predicting, s, 0.0).state.rotation.noise_scale, 1.0);
+  EXPECT_EQ(score_walk(WindowConfig{}, s, 0.0).state.rotation.noise_scale, std::pow(PredictionCheck::kScaleStep, PredictionCheck::kCandidates - 1));
 }
 
 TEST(PredictionCheckInTheEngine, ARestWeighsTheEstimate) {

@@ -51,7 +51,9 @@ class PredictionCheck {
   static double scale(int j);
 
   // evaluations_per_second: how often note() is called on a steady stream (the rate, or less).
-  void configure(double evaluations_per_second);
+  // lightest_first: the lightest candidate until the estimate is weighed (above); false where the
+  // lightest is not near the measurements (a horizon: it dead-reckons them, noise and all).
+  void configure(double evaluations_per_second, bool lightest_first);
   // The squared errors of each candidate's prediction of the newest measurement, candidate 0's
   // first (per component).
   void note(std::span<const double, kCandidates> squared_errors);
@@ -79,6 +81,7 @@ class PredictionCheck {
 
  private:
   double alpha_ = 0.0;  // the average's weight for one comparison
+  bool lightest_first_ = true;
   State s_;
 };
 
