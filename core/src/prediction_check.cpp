@@ -24,25 +24,27 @@ void PredictionCheck::note(std::span<const double, kCandidates> squared_errors) 
   const double a = std::max(1.0 / s_.count, alpha_);
   // The variance of such a mean per unit variance: 1/count, then a/(2 − a).
   const double spread = a > alpha_ ? a : a / (2.0 - a);
+  // The standard error of candidate j's mean difference.
+  const auto standard_error = [&](std::size_t j) {
+    return std::sqrt(std::max(0.0, s_.mean_square[j] - s_.mean[j] * s_.mean[j]) * spread);
+  };
   int best = 0;
   double best_mean = 0.0;
   for (std::size_t j = 1; j < kCandidates; ++j) {
     const double d = squared_errors[j] - squared_errors[0];
     s_.mean[j] += a * (d - s_.mean[j]);
     s_.mean_square[j] += a * (d * d - s_.mean_square[j]);
-    const double variance = std::max(0.0, s_.mean_square[j] - s_.mean[j] * s_.mean[j]);
-    if (s_.count >= kMinSamples && s_.mean[j] < best_mean && s_.mean[j] < -kSignificance * std::sqrt(variance * spread)) {
+    if (s_.count >= kMinSamples && s_.mean[j] < best_mean && s_.mean[j] < -kSignificance * standard_error(j)) {
       best = static_cast<int>(j);
       best_mean = s_.mean[j];
     }
   }
   if (!s_.weighed) {
     constexpr auto l = static_cast<std::size_t>(kCandidates - 1);
-    const double variance = std::max(0.0, s_.mean_square[l] - s_.mean[l] * s_.mean[l]);
     if (s_.count >= kMinSamples) {
       s_.weighed = true;
       if (best == 0) s_.choice = kCandidates - 1;  // and stays while it predicts better (below)
-    } else if (s_.count >= kFirstSpread && s_.mean[l] > kSignificance * std::sqrt(variance * spread)) {
+    } else if (s_.count >= kFirstSpread && s_.mean[l] > kSignificance * standard_error(l)) {
       s_.weighed = true;
     }
   }
