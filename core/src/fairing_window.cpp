@@ -4,6 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -633,27 +634,57 @@ std::span<const Vec3> FairingWindow::rest_increments(int count) {
   return std::span<const Vec3>(rest_zeta_).first(static_cast<std::size_t>(count));
 }
 
-// At rest on the rest line: where the newest sample (not held) lands from the line's prediction
-// for it. Off it by more than the noise could put it, it is kept out of the line; off it twice
-// running, on the same side, it is a motion starting (a noise spike, which a heavy-tailed noise
-// has now and then, is alone) and is emitted unsmoothed: the line would hold it at the still
-// pose until the motion estimate takes the motion, after its fit has stood over the onset
-// threshold twice. Not while predicting: the level-0 prediction carries one noisy step over the
-// horizon, worse than the line (quality benchmark, rests set at 20 ms: +0.9%).
+// At rest on the rest line: where the newest sample lands from the line's prediction for it (a
+// held one: only as it is emitted, as measured at lag 0). Off it by more than the noise could put
+// it, it is kept out of the line; off it twice running, on the same side, it is a motion starting
+// (a noise spike, which a heavy-tailed noise has now and then, is alone) and is emitted
+// unsmoothed: the line would hold it at the still pose until the motion estimate takes the
+// motion, after its fit has stood over the onset threshold twice. The first off the line is
+// emitted unsmoothed too where the stream's first samples off it have mostly begun motions
+// (Channel::Departures). Not while predicting: the level-0 prediction carries one noisy step over
+// the horizon, worse than the line (quality benchmark, rests set at 20 ms: +0.9%).
 FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch) {
   const Vec3 before = ch.rest.departure;  // zero unless the sample before was off the line
   ch.rest.departure = Vec3::Zero();
-  const char held = &ch == &rot_ ? kHeldRotation : kHeldPosition;
-  if (config_.horizon_s > 0.0 || !ch.adaptive || !ch.rest.resting || n_ != w_ || (newest_held_ & held) != 0)
-    return Departure::None;
   const auto newest = static_cast<std::size_t>(n_ - 1);
+  const double time = samples_[newest].time;
+  Channel::Departures& d = ch.departures;
+  // The first sample after one that was the first off the line tells what that one was (once:
+  // a held sample's estimate is made again when it is put back or released).
+  const bool judging = time > d.first_off_time;
+  if (judging) d.first_off_time = std::numeric_limits<double>::infinity();
+  auto judged = [&](bool start) {
+    if (!judging) return;
+    d.starts *= kDepartureMemory;
+    d.spikes *= kDepartureMemory;
+    (start ? d.starts : d.spikes) += 1.0;
+  };
+  const char held = &ch == &rot_ ? kHeldRotation : kHeldPosition;
+  if (config_.horizon_s > 0.0 || !ch.adaptive || n_ != w_) return Departure::None;
+  if ((newest_held_ & held) != 0 && !emitting_held_) {
+    judged(false);  // the guard holds it: alone, or a burst
+    return Departure::None;
+  }
+  if (!ch.rest.resting) {
+    judged(true);  // rest ended with it: the motion estimate took the motion
+    return Departure::None;
+  }
   const double noise = ch.estimator.noise_variance();
-  const std::optional<Vec3> line = ch.rest.line.line_at(ch.rest.time - samples_[newest].time);
+  const std::optional<Vec3> line = ch.rest.line.line_at(ch.rest.time - time);
   if (!line) return Departure::None;
   const Vec3 e = rest_coordinate(ch, n_ - 1) - *line;
-  if (!(e.squaredNorm() / 3.0 > kRestDepartureFactor * noise)) return Departure::None;
+  if (!(e.squaredNorm() / 3.0 > kRestDepartureFactor * noise)) {
+    judged(false);
+    return Departure::None;
+  }
   ch.rest.departure = e;
-  return e.dot(before) > 0.5 * before.squaredNorm() ? Departure::Moving : Departure::Off;
+  const bool moving = e.dot(before) > 0.5 * before.squaredNorm();
+  judged(moving);
+  if (moving) return Departure::Moving;
+  d.first_off_time = time;
+  // Held at the still pose, a motion's first sample costs what a spike let through does: so it
+  // goes out as measured where the first samples off the line have more often begun motions.
+  return d.starts > d.spikes ? Departure::Moving : Departure::Off;
 }
 
 // Sample j in the rest line's coordinate, from the rest's first sample: positions, p_j − p_0;
@@ -848,6 +879,7 @@ int FairingWindow::start_afresh(std::span<FairedPose> out) {
   for (Channel* ch : {&rot_, &pos_}) {
     ch->estimator.restore({});
     ch->rest = Channel::Rest{};
+    ch->departures.first_off_time = std::numeric_limits<double>::infinity();
     ch->mu = 0.0;
     ch->level = 0.0;
     ch->check.restart();
@@ -985,7 +1017,9 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   if (linear) {
     // Only the emitted sample's estimate is needed: one precomputed dot product (two while
     // the adapted smoothing lies between levels).
+    emitting_held_ = emit_measured;
     linear_emission_estimate(k, dt);
+    emitting_held_ = false;
     // A prediction the window cannot make (its rate not yet known, or its only sample the
     // first after a gap) is the last step carried on at its real duration: dead reckoning.
     // Never over a step shorter than the stream's interval (the rate, or before it is known the

@@ -199,6 +199,14 @@ class FairingWindow {
       // go out as measured while the level's correction stands over the noise (linear_emission_estimate).
       int leaving = 0;
     } rest;
+    // What the stream's first samples off the rest line turned out to be (departs_from_rest), each
+    // judgement's weight decayed by kDepartureMemory per later one: a motion starting (the next
+    // sample off on the same side, or rest ended) or alone (a noise spike, a glitch). The prior:
+    // one spike. Kept over held samples and restarts: it is the stream's.
+    struct Departures {
+      double first_off_time = std::numeric_limits<double>::infinity();  // the newest first off, to judge
+      double starts = 0.0, spikes = 1.0;
+    } departures;
     // The noise estimate checked by the next measurement (prediction_check.hpp): its candidates'
     // levels, chosen with the noise scaled by PredictionCheck::scale(j).
     PredictionCheck check;
@@ -241,7 +249,8 @@ class FairingWindow {
   enum class Departure { None, Off, Moving };
   Departure departs_from_rest(Channel& ch);
   Vec3 rest_coordinate(const Channel& ch, int j) const;
-  char newest_held_ = 0;  // the channels whose newest sample the guard held (kHeld*; at lag 0 emitted as measured all the same)
+  char newest_held_ = 0;
+  bool emitting_held_ = false;  // the newest sample, held, is being estimated as measured to emit it (lag 0)  // the channels whose newest sample the guard held (kHeld*; at lag 0 emitted as measured all the same)
   void note_correction(Channel& ch, int k, const Vec3& u, double dt);
   struct LevelRows {
     const EmissionRow& a;

@@ -41,6 +41,9 @@ inline constexpr double kLevelBiasFactor = 2.0;
 // (a χ² with 3 degrees of freedom over 36). At 8, heavy-tailed noise (Student's t, 4 degrees of
 // freedom) at 1 kHz nearly tripled a still stream's jitter.
 inline constexpr double kRestDepartureFactor = 12.0;
+// The weight a judgement of what a first sample off the line was keeps per later judgement
+// (FairingWindow::Channel::Departures): about the last ten count.
+inline constexpr double kDepartureMemory = 0.9;
 
 class RestLine {
  public:
