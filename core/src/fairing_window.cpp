@@ -658,6 +658,7 @@ FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch) {
     d.starts *= kDepartureMemory;
     d.spikes *= kDepartureMemory;
     (start ? d.starts : d.spikes) += 1.0;
+    if (start) d.start_square = std::max(kDepartureMemory * d.start_square, d.first_off_square);
   };
   const char held = &ch == &rot_ ? kHeldRotation : kHeldPosition;
   if (config_.horizon_s > 0.0 || !ch.adaptive || n_ != w_) return Departure::None;
@@ -682,9 +683,13 @@ FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch) {
   judged(moving);
   if (moving) return Departure::Moving;
   d.first_off_time = time;
+  d.first_off_square = e.squaredNorm();
   // Held at the still pose, a motion's first sample costs what a spike let through does: so it
-  // goes out as measured where the first samples off the line have more often begun motions.
-  return d.starts > d.spikes ? Departure::Moving : Departure::Off;
+  // goes out as measured where the first samples off the line have more often begun motions, and
+  // it is no further off than theirs (twice the furthest): a glitch far off, which the guard holds
+  // for the poses after it, still goes out at the still pose.
+  const bool like_a_start = d.starts > d.spikes && d.first_off_square <= kDepartureReach * kDepartureReach * d.start_square;
+  return like_a_start ? Departure::Moving : Departure::Off;
 }
 
 // Sample j in the rest line's coordinate, from the rest's first sample: positions, p_j − p_0;

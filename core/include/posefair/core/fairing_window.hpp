@@ -206,6 +206,8 @@ class FairingWindow {
     struct Departures {
       double first_off_time = std::numeric_limits<double>::infinity();  // the newest first off, to judge
       double starts = 0.0, spikes = 1.0;
+      double first_off_square = 0.0;  // ‖e‖² of the newest first off, from the line's prediction
+      double start_square = 0.0;      // the furthest of those that began motions (decayed alike)
     } departures;
     // The noise estimate checked by the next measurement (prediction_check.hpp): its candidates'
     // levels, chosen with the noise scaled by PredictionCheck::scale(j).

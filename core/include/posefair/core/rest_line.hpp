@@ -44,6 +44,9 @@ inline constexpr double kRestDepartureFactor = 12.0;
 // The weight a judgement of what a first sample off the line was keeps per later judgement
 // (FairingWindow::Channel::Departures): about the last ten count.
 inline constexpr double kDepartureMemory = 0.9;
+// How much further off than the furthest that began a motion a first sample off the line may be
+// and still be taken for one.
+inline constexpr double kDepartureReach = 4.0;
 
 class RestLine {
  public:
