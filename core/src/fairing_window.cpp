@@ -686,8 +686,8 @@ FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch) {
   d.first_off_square = e.squaredNorm();
   // Held at the still pose, a motion's first sample costs what a spike let through does: so it
   // goes out as measured where the first samples off the line have more often begun motions, and
-  // it is no further off than theirs (twice the furthest): a glitch far off, which the guard holds
-  // for the poses after it, still goes out at the still pose.
+  // it is no further off than theirs (kDepartureReach times the furthest): a glitch far beyond a
+  // motion's first step is not taken for one.
   const bool like_a_start = d.starts > d.spikes && d.first_off_square <= kDepartureReach * kDepartureReach * d.start_square;
   return like_a_start ? Departure::Moving : Departure::Off;
 }

@@ -251,8 +251,8 @@ class FairingWindow {
   enum class Departure { None, Off, Moving };
   Departure departs_from_rest(Channel& ch);
   Vec3 rest_coordinate(const Channel& ch, int j) const;
-  char newest_held_ = 0;
-  bool emitting_held_ = false;  // the newest sample, held, is being estimated as measured to emit it (lag 0)  // the channels whose newest sample the guard held (kHeld*; at lag 0 emitted as measured all the same)
+  char newest_held_ = 0;  // the channels whose newest sample the guard held (kHeld*; at lag 0 emitted as measured all the same)
+  bool emitting_held_ = false;  // that sample's estimate is being made as measured, to emit it (lag 0)
   void note_correction(Channel& ch, int k, const Vec3& u, double dt);
   struct LevelRows {
     const EmissionRow& a;
