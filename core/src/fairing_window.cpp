@@ -181,6 +181,7 @@ FairingWindow::FairingWindow(const WindowConfig& config)
       target_spec_{config.order, config.lag, 0.0, config.continuity},
       builder_(capacity_, config.order),
       fill_row_(make_emission_row(capacity_)),
+      fill_newest_row_(make_emission_row(capacity_)),
       rot_(capacity_, config.order),
       pos_(capacity_, config.order),
       rot_guard_(outlier_threshold(config), 0.5),  // log gives half the rotation angle
@@ -364,6 +365,7 @@ void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
     ch.check.state().since_check_s += dt;
   }
   if (!refreshed) return;  // the level follows the motion estimate's refreshes
+  ch.filling_moved = false;  // the motion estimate has the samples since the gap
   // A motion that stopped and is still in the window: each level's drag towards it counts too.
   const MotionNoiseEstimator::StoppedMotion stopped = estimator.stopped_motion(w_);
   const std::span<const double> tail =
@@ -515,9 +517,23 @@ Vec3 FairingWindow::linear_correction(Channel& ch, std::span<const Vec3> zeta, s
     return apply_rows(a, levels_[static_cast<std::size_t>(i + 1)], f, n_, zeta);
   }
   // A window still filling (after the start or a gap): its row, built for this fill level.
-  if (ch.mu == 0.0 && config_.horizon_s == 0.0) return Vec3::Zero();
-  builder_.build(n_, ch.mu, target_spec_, fill_row_);
+  if (!ch.filling_moved && fill_moves(ch, zeta)) ch.filling_moved = true;
+  const double mu = ch.filling_moved ? 0.0 : ch.mu;
+  if (mu == 0.0 && config_.horizon_s == 0.0) return Vec3::Zero();
+  builder_.build(n_, mu, target_spec_, fill_row_);
   return apply_row(fill_row_, n_, zeta, c, emitted, continuity);
+}
+
+// A window filling again after a gap smooths as the adaptation chose before it (Channel::
+// filling_moved): true where that smoothing's estimate of the newest sample stands off it by more
+// than the noise could put it (as a sample off the rest line: kRestDepartureFactor), a motion the
+// fits cannot see yet. Not for a gyro-aided rotation (its own estimator).
+bool FairingWindow::fill_moves(const Channel& ch, std::span<const Vec3> zeta) {
+  const MotionNoiseEstimator& e = ch.estimator;
+  if (!ch.adaptive || !(ch.mu > 0.0) || !e.ready() || (&ch == &rot_ && aided_)) return false;
+  builder_.build(n_, ch.mu, EmissionTarget{config_.order, 0, 0.0, 0.0}, fill_newest_row_);
+  const Vec3 u = apply_row(fill_newest_row_, n_, zeta, {}, n_ - 1, false);
+  return u.squaredNorm() / 3.0 > kRestDepartureFactor * e.noise_variance();
 }
 
 // With κ > 0 every emitted orientation feeds back into later ones: in a full window the
@@ -798,7 +814,7 @@ std::size_t FairingWindow::memory_bytes() const {
   for (const EmissionRow& r : levels_) bytes += row_bytes(r);
   bytes += next_rows_.capacity() * sizeof(EmissionRow);
   for (const EmissionRow& r : next_rows_) bytes += row_bytes(r);
-  bytes += row_bytes(fill_row_) + row_bytes(rot_.fixed) + row_bytes(pos_.fixed);
+  bytes += row_bytes(fill_row_) + row_bytes(fill_newest_row_) + row_bytes(rot_.fixed) + row_bytes(pos_.fixed);
   // The builder's band matrix and scratch, and the three estimators' fit, half-span fit, window
   // fit and line weights.
   bytes += static_cast<std::size_t>(capacity_) * (static_cast<std::size_t>(config_.order + 1) + 5) * sizeof(double) +
@@ -853,6 +869,7 @@ int FairingWindow::emit_pending(std::span<FairedPose> out) {
   if (config_.solver == WindowSolver::Linear && first_unemitted() < n_) solve();
   for (int i = first_unemitted(); i < n_; ++i) out[static_cast<std::size_t>(count++)] = emit(i);
   n_ = 0;
+  rot_.filling_moved = pos_.filling_moved = false;
   return count;
 }
 
@@ -1077,6 +1094,7 @@ void FairingWindow::restore(Channel& ch, const Learnt& l) {
   ch.rest = l.rest;
   ch.check.state() = l.check;
   ch.candidate_level = l.candidate_level;
+  ch.filling_moved = l.filling_moved;
 }
 
 void FairingWindow::slide(int count) {

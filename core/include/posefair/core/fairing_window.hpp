@@ -213,6 +213,11 @@ class FairingWindow {
     // levels, chosen with the noise scaled by PredictionCheck::scale(j).
     PredictionCheck check;
     std::array<double, PredictionCheck::kCandidates> candidate_level{};
+    // A window filling again after a gap smooths as the adaptation last chose (at rest, as hard as
+    // it can), though its fits cannot see a motion until they span enough samples: set where a
+    // sample stood off the fill's estimate by more than the noise could put it (fill_moves), and
+    // the window then fills unsmoothed until the motion estimate is refreshed.
+    bool filling_moved = false;
   };
   // What a channel's adaptation had learnt before a held sample went in: put back when the next
   // sample releases it, and the released sample learnt from as measured, so that a released
@@ -223,9 +228,10 @@ class FairingWindow {
     Channel::Rest rest;
     PredictionCheck::State check;
     std::array<double, PredictionCheck::kCandidates> candidate_level{};
+    bool filling_moved = false;
   };
   static Learnt learnt(const Channel& ch) {
-    return {ch.estimator.estimates(), ch.mu, ch.level, ch.rest, ch.check.state(), ch.candidate_level};
+    return {ch.estimator.estimates(), ch.mu, ch.level, ch.rest, ch.check.state(), ch.candidate_level, ch.filling_moved};
   }
   static void restore(Channel& ch, const Learnt& l);
 
@@ -262,6 +268,7 @@ class FairingWindow {
   LevelRows level_rows(const Channel& ch) const;
   double correction_gain(const Channel& ch) const;  // of the level in use
   Vec3 linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c);
+  bool fill_moves(const Channel& ch, std::span<const Vec3> zeta);
   void follow_rest(Channel& ch, bool departs);
   Vec3 rest_blend(Channel& ch, int k, const Vec3& window, double dt);
   void linear_emission_estimate(int k, double dt);
@@ -333,6 +340,7 @@ class FairingWindow {
   // the newest (c < W − 1).
   std::vector<double> level_tail_bias_;
   EmissionRow fill_row_;             // scratch: the row of a window still filling
+  EmissionRow fill_newest_row_;      // scratch: its estimate of the newest sample (fill_moves)
   Channel rot_, pos_;
   OutlierGuard rot_guard_, pos_guard_;
   // Before the newest sample was held: both channels' adaptation, and the step it came after
