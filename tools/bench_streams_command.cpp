@@ -91,7 +91,7 @@ int bench_streams(const std::string& out_dir, bool quick) {
     return exit_code(ErrorKind::CantCreate);
   }
   csv << "stream,motion,rate_hz,noise,raw,default,one_euro_default,best_posefair,best_posefair_config,best_one_euro,"
-         "best_one_euro_config,raw_jitter,default_jitter,source_hz,resampling\n";
+         "best_one_euro_config,raw_jitter,default_jitter,source_hz,resampling,dropouts_per_s\n";
   std::vector<StreamRow> rows;
   for (const GeneratedStreamSpec& spec : generated_stream_specs(quick)) {
     rows.push_back(run_stream(spec));
@@ -99,7 +99,7 @@ int bench_streams(const std::string& out_dir, bool quick) {
     csv << spec.name() << ',' << spec.motion << ',' << spec.rate_hz << ',' << spec.noise << ',' << r.raw << ',' << r.fair << ','
         << r.one_euro << ',' << r.best_fair.error << ",\"" << r.best_fair.config << "\"," << r.best_one_euro.error << ",\""
         << r.best_one_euro.config << "\"," << r.raw_jitter << ',' << r.fair_jitter << ',' << spec.source_hz << ',' << spec.resampling
-        << '\n';
+        << ',' << spec.dropouts_per_s << '\n';
   }
 
   std::printf("## Generated streams: the defaults where nothing was tuned\n\n");

@@ -89,6 +89,36 @@ std::function<Quat(double)> walk(std::mt19937_64& rng, double seconds, double dt
   };
 }
 
+// Removes runs of 4 to 12 samples from the stream, starting at times a Poisson process of
+// `per_s` a second puts them (from its first sample on), with a sample kept between two.
+void drop_runs(QualitySequence& s, double per_s, std::mt19937_64 rng) {
+  std::exponential_distribution<double> until_next(per_s);
+  std::uniform_int_distribution<int> run(4, 12);
+  QualitySequence kept = s;
+  kept.input.time.clear();
+  kept.input.orientation.clear();
+  kept.use.clear();
+  double next = s.input.time.front() + until_next(rng);
+  int lost = 0;
+  bool kept_one = true;  // a sample kept since the last run (two runs back to back are one)
+  for (std::size_t i = 0; i < s.input.size(); ++i) {
+    if (lost == 0 && kept_one && s.input.time[i] >= next) {
+      lost = run(rng);
+      next = s.input.time[i] + until_next(rng);
+    }
+    if (lost > 0) {
+      --lost;
+      kept_one = false;
+      continue;
+    }
+    kept_one = true;
+    kept.input.time.push_back(s.input.time[i]);
+    kept.input.orientation.push_back(s.input.orientation[i]);
+    kept.use.push_back(s.use[i]);
+  }
+  s = std::move(kept);
+}
+
 }  // namespace
 
 std::string GeneratedStreamSpec::name() const {
@@ -97,7 +127,7 @@ std::string GeneratedStreamSpec::name() const {
     std::snprintf(b, sizeof b, "%s-%gHz-noise%g-from%gHz-%s", motion.c_str(), rate_hz, noise, source_hz, resampling.c_str());
   else
     std::snprintf(b, sizeof b, "%s-%gHz-noise%g", motion.c_str(), rate_hz, noise);
-  return b;
+  return dropouts_per_s > 0.0 ? std::string(b) + "-dropouts" : std::string(b);
 }
 
 std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick) {
@@ -112,11 +142,16 @@ std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick) {
       for (double noise : {0.0002, 0.002, 0.01, 0.04}) out.push_back({motion, rate, noise, rate > 500.0 ? 10.0 : 20.0, 0.0, {}});
   for (const char* motion : {"still", "sway", "turns", "walk"})
     for (const char* resampling : {"hold", "linear"}) out.push_back({motion, 250.0, 0.01, 20.0, 60.0, resampling});
+  for (const char* motion : {"still", "sway", "turns", "walk"})
+    for (double noise : {0.002, 0.01}) out.push_back({motion, 120.0, noise, 20.0, 0.0, {}, 1.0});
   return out;
 }
 
 QualitySequence generated_stream(const GeneratedStreamSpec& spec) {
-  std::mt19937_64 rng(seed_of(spec.name()));
+  // With dropouts, the same stream as without them, less the runs it loses.
+  GeneratedStreamSpec whole = spec;
+  whole.dropouts_per_s = 0.0;
+  std::mt19937_64 rng(seed_of(whole.name()));
   const double dense_rate = std::max(8.0 * spec.rate_hz, 2000.0);
   std::function<Quat(double)> truth_at;
   if (spec.motion == "still") {
@@ -172,6 +207,7 @@ QualitySequence generated_stream(const GeneratedStreamSpec& spec) {
   s.truth = TruthTrack(std::move(time), std::move(orientation), 1.5 / dense_rate);
   s.use.assign(n, 1);
   for (std::size_t i = 0; i < n && static_cast<double>(i) < kWarmUpSeconds * spec.rate_hz; ++i) s.use[i] = 0;
+  if (spec.dropouts_per_s > 0.0) drop_runs(s, spec.dropouts_per_s, std::mt19937_64(seed_of(spec.name()) + 1));
   return s;
 }
 

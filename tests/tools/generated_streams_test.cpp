@@ -1,5 +1,5 @@
 // tools/generated_streams.cpp: the streams of `posefair bench streams`, here the resampled ones
-// (a tracker polled faster than it updates, a log put on another clock).
+// (a tracker polled faster than it updates, a log put on another clock) and those with dropouts.
 #include <cmath>
 #include <stdexcept>
 
@@ -48,6 +48,34 @@ TEST(GeneratedStreams, ALinearStreamSlerpsBetweenTheSourceMeasurements) {
   EXPECT_NEAR(equal_increments(linear), 4998 * 14 / 25, 2);
   EXPECT_EQ(equal_increments(native), 0);
   EXPECT_EQ(changes(linear), 4999);
+}
+
+TEST(GeneratedStreams, AStreamWithDropoutsLosesRunsOfFourToTwelveSamples) {
+  const QualitySequence full = generated_stream({"turns", 120.0, 0.01, 20.0, 0.0, {}});
+  const QualitySequence dropped = generated_stream({"turns", 120.0, 0.01, 20.0, 0.0, {}, 1.0});
+  EXPECT_EQ(dropped.name, "turns-120Hz-noise0.01-dropouts");
+  ASSERT_EQ(dropped.input.size(), dropped.use.size());
+  // What is kept is the stream without dropouts, sample for sample; what is lost comes in runs.
+  std::size_t j = 0;
+  int runs = 0;
+  for (std::size_t i = 0; i < dropped.input.size(); ++i) {
+    const std::size_t from = j;
+    while (j < full.input.size() && full.input.time[j] < dropped.input.time[i]) ++j;
+    ASSERT_LT(j, full.input.size());
+    ASSERT_EQ(full.input.time[j], dropped.input.time[i]);
+    EXPECT_TRUE(full.input.orientation[j].coeffs() == dropped.input.orientation[i].coeffs());
+    EXPECT_EQ(full.use[j], dropped.use[i]);
+    const std::size_t lost = j - from;
+    if (lost > 0) {
+      ++runs;
+      EXPECT_GE(lost, 4u);
+      EXPECT_LE(lost, 12u);
+    }
+    ++j;
+  }
+  // One a second on average over 20 s.
+  EXPECT_GE(runs, 8);
+  EXPECT_LE(runs, 35);
 }
 
 TEST(GeneratedStreams, AnUnknownResamplingIsAnError) {
