@@ -686,11 +686,10 @@ FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch) {
     judged(true);  // rest ended with it: the motion estimate took the motion
     return Departure::None;
   }
-  const double noise = ch.estimator.noise_variance();
-  const std::optional<Vec3> line = ch.rest.line.line_at(ch.rest.time - time);
-  if (!line) return Departure::None;
-  const Vec3 e = rest_coordinate(ch, n_ - 1) - *line;
-  if (!(e.squaredNorm() / 3.0 > kRestDepartureFactor * noise)) {
+  const std::optional<Vec3> off = from_rest_line(ch);
+  if (!off) return Departure::None;
+  const Vec3 e = *off;
+  if (!(e.squaredNorm() / 3.0 > kRestDepartureFactor * ch.estimator.noise_variance())) {
     judged(false);
     return Departure::None;
   }
@@ -708,6 +707,14 @@ FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch) {
   return like_a_start ? Departure::Moving : Departure::Off;
 }
 
+// Where the newest sample lands from the rest line's prediction for it (none where the line has
+// none).
+std::optional<Vec3> FairingWindow::from_rest_line(const Channel& ch) const {
+  const std::optional<Vec3> line = ch.rest.line.line_at(ch.rest.time - samples_[static_cast<std::size_t>(n_ - 1)].time);
+  if (!line) return std::nullopt;
+  return rest_coordinate(ch, n_ - 1) - *line;
+}
+
 // Sample j in the rest line's coordinate, from the rest's first sample: positions, p_j − p_0;
 // rotations, log(R⁻¹z_j) with R its pose. Not the sum of the rotation increments since then:
 // each pair of noisy increments adds a term of the order of their product, and over seconds of
@@ -722,7 +729,9 @@ Vec3 FairingWindow::rest_coordinate(const Channel& ch, int j) const {
 // taken while no motion is seen (the heaviest level), in rest_coordinate.
 void FairingWindow::follow_rest(Channel& ch, bool departs) {
   const double memory = config_.adaptation.rest_memory_s;
-  const bool still = ch.adaptive && prepared_ && memory > 0.0 && !(&ch == &rot_ && aided_) && n_ == w_ &&
+  // A rest goes on while the window fills again after a gap (the still pose is the same after
+  // it); one begins on a full window only.
+  const bool still = ch.adaptive && prepared_ && memory > 0.0 && !(&ch == &rot_ && aided_) && (n_ == w_ || ch.rest.resting) &&
                      ch.estimator.at_rest();
   if (!still) {
     ch.rest.resting = false;
@@ -742,6 +751,15 @@ void FairingWindow::follow_rest(Channel& ch, bool departs) {
     }
   };
   if (ch.rest.resting) {
+    // Filling again after a gap (which the departure rules do not judge), the rest goes on while
+    // the samples stay on the line; one off it ends it (the tracker moved in the gap, or now).
+    if (n_ != w_) {
+      const std::optional<Vec3> off = from_rest_line(ch);
+      if (!off || off->squaredNorm() / 3.0 > kRestDepartureFactor * ch.estimator.noise_variance()) {
+        ch.rest.resting = false;
+        return;
+      }
+    }
     if (!departs) feed(n_ - 1);  // a sample that left the still pose is no part of it
     return;
   }

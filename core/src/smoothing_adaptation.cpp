@@ -306,8 +306,10 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
   if (e_.motion_ready) {
     const double threshold = settings_.rest_threshold;
     const double line_noise = e_.noise_var * line_noise_gain_;
-    e_.at_rest = settings_.motion_floor && threshold > 0.0 && e_.line_ready &&
-               e_.line_mean_square < (e_.at_rest ? kRestLeaveFactor : 1.0) * threshold * line_noise;
+    // While the line is not ready again (a window filling after a gap, which the line does not
+    // span) a rest stays a rest: FairingWindow ends it where a sample leaves the rest line.
+    e_.at_rest = settings_.motion_floor && threshold > 0.0 &&
+                 (e_.line_ready ? e_.line_mean_square < (e_.at_rest ? kRestLeaveFactor : 1.0) * threshold * line_noise : e_.at_rest);
     if (e_.at_rest) {
       // The average counts only while a fit stands clear of the noise too: the newest (a motion
       // starting) or one of the last span (a vibration).

@@ -257,6 +257,7 @@ class FairingWindow {
   enum class Departure { None, Off, Moving };
   Departure departs_from_rest(Channel& ch);
   Vec3 rest_coordinate(const Channel& ch, int j) const;
+  std::optional<Vec3> from_rest_line(const Channel& ch) const;
   char newest_held_ = 0;  // the channels whose newest sample the guard held (kHeld*; at lag 0 emitted as measured all the same)
   bool emitting_held_ = false;  // that sample's estimate is being made as measured, to emit it (lag 0)
   void note_correction(Channel& ch, int k, const Vec3& u, double dt);
