@@ -106,7 +106,7 @@ int bench_streams(const std::string& out_dir, bool quick) {
   std::printf("%zu streams (%s), error (a) in rad, RMS at the delivery time, the first second left out; percentages against\n"
               "raw. Best on the stream: each family's lowest error among its configurations at lag 0, picked on that stream\n"
               "itself (posefair: m × 10 smoothings × 2 windows; One Euro: 80), an upper bound on what tuning it could do.\n\n",
-              rows.size(), quick ? "--quick" : "5 motions × 6 rates × 4 noise levels, and 4 motions measured at 60 Hz, resampled to 250 Hz 2 ways");
+              rows.size(), quick ? "--quick" : "5 motions × 6 rates × 4 noise levels, 4 motions measured at 60 Hz, resampled to 250 Hz 2 ways, and 4 motions at 120 Hz under 2 noise levels with dropouts");
   std::printf("| stream | raw | posefair default | best posefair on the stream | default against it | One Euro default | best One Euro on the stream | default against it |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
   for (const StreamRow& r : rows)
