@@ -438,6 +438,10 @@ void FairingWindow::compare_predictions(Channel& ch, std::span<const Vec3> zeta)
 namespace {
 
 // u = Σ_j row.zeta_j ζ_j (+ Σ_i row.c_i c_i over emitted samples).
+// A difference e off what the noise of variance noise_var (per component, as it reaches e) could
+// put there: its mean square per component over kRestDepartureFactor times that.
+bool off_beyond_noise(const Vec3& e, double noise_var) { return e.squaredNorm() / 3.0 > kRestDepartureFactor * noise_var; }
+
 Vec3 apply_row(const EmissionRow& row, int n, std::span<const Vec3> zeta, std::span<const Vec3> c, int emitted, bool continuity) {
   Vec3 e = weighted_vector_sum(row.first, n - 1, [&](int j) { return row.zeta[static_cast<std::size_t>(j)]; }, zeta);
   if (continuity) e += weighted_vector_sum(row.first, emitted, [&](int i) { return row.c[static_cast<std::size_t>(i)]; }, c);
@@ -533,7 +537,7 @@ bool FairingWindow::fill_moves(const Channel& ch, std::span<const Vec3> zeta) {
   if (!ch.adaptive || !(ch.mu > 0.0) || !e.ready() || (&ch == &rot_ && aided_)) return false;
   builder_.build(n_, ch.mu, EmissionTarget{config_.order, 0, 0.0, 0.0}, fill_newest_row_);
   const Vec3 u = apply_row(fill_newest_row_, n_, zeta, {}, n_ - 1, false);
-  return u.squaredNorm() / 3.0 > kRestDepartureFactor * e.noise_variance();
+  return off_beyond_noise(u, e.noise_variance());
 }
 
 // With κ > 0 every emitted orientation feeds back into later ones: in a full window the
@@ -614,7 +618,7 @@ void FairingWindow::linear_emission_estimate(int k, double dt) {
     if (ch.rest.leaving > 0) {
       --ch.rest.leaving;
       if (departs == Departure::None && n_ == w_ &&
-          u.squaredNorm() / 3.0 > kRestDepartureFactor * ch.estimator.noise_variance() * correction_gain(ch))
+          off_beyond_noise(u, ch.estimator.noise_variance() * correction_gain(ch)))
         return Vec3::Zero();
       ch.rest.leaving = 0;
     }
@@ -689,7 +693,7 @@ FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch) {
   const std::optional<Vec3> off = from_rest_line(ch);
   if (!off) return Departure::None;
   const Vec3 e = *off;
-  if (!(e.squaredNorm() / 3.0 > kRestDepartureFactor * ch.estimator.noise_variance())) {
+  if (!off_beyond_noise(e, ch.estimator.noise_variance())) {
     judged(false);
     return Departure::None;
   }
@@ -755,7 +759,7 @@ void FairingWindow::follow_rest(Channel& ch, bool departs) {
     // the samples stay on the line; one off it ends it (the tracker moved in the gap, or now).
     if (n_ != w_) {
       const std::optional<Vec3> off = from_rest_line(ch);
-      if (!off || off->squaredNorm() / 3.0 > kRestDepartureFactor * ch.estimator.noise_variance()) {
+      if (!off || off_beyond_noise(*off, ch.estimator.noise_variance())) {
         ch.rest.resting = false;
         return;
       }
