@@ -94,13 +94,10 @@ std::function<Quat(double)> walk(std::mt19937_64& rng, double seconds, double dt
 void drop_runs(QualitySequence& s, double per_s, std::mt19937_64 rng) {
   std::exponential_distribution<double> until_next(per_s);
   std::uniform_int_distribution<int> run(4, 12);
-  QualitySequence kept = s;
-  kept.input.time.clear();
-  kept.input.orientation.clear();
-  kept.use.clear();
   double next = s.input.time.front() + until_next(rng);
   int lost = 0;
   bool kept_one = true;  // a sample kept since the last run (two runs back to back are one)
+  std::size_t kept = 0;  // the samples kept so far, compacted to the front (the truth is untouched)
   for (std::size_t i = 0; i < s.input.size(); ++i) {
     if (lost == 0 && kept_one && s.input.time[i] >= next) {
       lost = run(rng);
@@ -112,11 +109,14 @@ void drop_runs(QualitySequence& s, double per_s, std::mt19937_64 rng) {
       continue;
     }
     kept_one = true;
-    kept.input.time.push_back(s.input.time[i]);
-    kept.input.orientation.push_back(s.input.orientation[i]);
-    kept.use.push_back(s.use[i]);
+    s.input.time[kept] = s.input.time[i];
+    s.input.orientation[kept] = s.input.orientation[i];
+    s.use[kept] = s.use[i];
+    ++kept;
   }
-  s = std::move(kept);
+  s.input.time.resize(kept);
+  s.input.orientation.resize(kept);
+  s.use.resize(kept);
 }
 
 }  // namespace
