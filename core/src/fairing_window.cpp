@@ -200,6 +200,7 @@ FairingWindow::FairingWindow(const WindowConfig& config)
   est_.resize(w);
   window_clamped_.assign(w, 0);
   held_.assign(w, 0);
+  stand_in_.assign(w, 0);
   c_.resize(w);
   dzp_.resize(w);
   cp_.resize(w);
@@ -352,7 +353,8 @@ void FairingWindow::prepare(double rate_hz) {
 void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
   if (!ch.adaptive || !prepared_) return;
   MotionNoiseEstimator& estimator = &ch == &rot_ && aided_ ? aided_estimator_ : ch.estimator;
-  const bool refreshed = estimator.update(zeta, dt, &ch == &rot_ ? rest_increments(static_cast<int>(zeta.size())) : std::span<const Vec3>{});
+  const bool refreshed = estimator.update(zeta, dt, &ch == &rot_ ? rest_increments(static_cast<int>(zeta.size())) : std::span<const Vec3>{},
+                                          since_stand_in_);
   if (!estimator.ready()) {
     ch.level = 0.0;
     ch.mu = 0.0;
@@ -427,7 +429,7 @@ void FairingWindow::compare_predictions(Channel& ch, std::span<const Vec3> zeta)
   if (!s.predicted) return;
   s.predicted = false;
   if (n_ != w_ || zeta.size() != static_cast<std::size_t>(w_ - 1) || ch.estimator.at_rest() || ch.rest.resting ||
-      ch.rest.leaving > 0)
+      ch.rest.leaving > 0 || since_stand_in_ < 2)  // (the newest increment reaches a stand-in: not a measurement's)
     return;
   const Vec3& newest = zeta.back();
   std::array<double, PredictionCheck::kCandidates> errors{};
@@ -681,7 +683,7 @@ FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch) {
     if (start) d.start_square = std::max(kDepartureMemory * d.start_square, d.first_off_square);
   };
   const char held = &ch == &rot_ ? kHeldRotation : kHeldPosition;
-  if (config_.horizon_s > 0.0 || !ch.adaptive || n_ != w_) return Departure::None;
+  if (config_.horizon_s > 0.0 || !ch.adaptive || n_ != w_ || since_stand_in_ == 0) return Departure::None;  // (a stand-in measures nothing)
   if ((newest_held_ & held) != 0 && !emitting_held_) {
     judged(false);  // the guard holds it: alone, or a burst
     return Departure::None;
@@ -744,6 +746,9 @@ void FairingWindow::follow_rest(Channel& ch, bool departs) {
   auto feed = [&](int from) {
     for (int i = from; i < n_; ++i) {
       const auto j = static_cast<std::size_t>(i);
+      // A stand-in for a lost sample is no measurement: its noise is its neighbours', which the
+      // line's test of straightness would count twice.
+      if (stand_in_[j]) continue;
       const bool first = ch.rest.line.empty();
       if (first) {
         ch.rest.reference = z_[j];
@@ -757,7 +762,7 @@ void FairingWindow::follow_rest(Channel& ch, bool departs) {
   if (ch.rest.resting) {
     // Filling again after a gap (which the departure rules do not judge), the rest goes on while
     // the samples stay on the line; one off it ends it (the tracker moved in the gap, or now).
-    if (n_ != w_) {
+    if (n_ != w_ && since_stand_in_ > 0) {
       const std::optional<Vec3> off = from_rest_line(ch);
       if (!off || off_beyond_noise(*off, ch.estimator.noise_variance())) {
         ch.rest.resting = false;
@@ -830,7 +835,8 @@ std::size_t FairingWindow::memory_bytes() const {
   bytes += (zeta_.capacity() + residual_.capacity() + rest_zeta_.capacity() + est_.capacity() + c_.capacity() + dzp_.capacity() + cp_.capacity()) * sizeof(Vec3);
   bytes += (zp_.capacity() + xp_.capacity() + yp_.capacity() + e_.capacity() + u_.capacity() + w_scratch_.capacity() +
             rhs_.capacity()) * sizeof(Vec3);
-  bytes += (diag_.capacity() + sampled_step_.capacity() + stamp_.capacity()) * sizeof(double) + window_clamped_.capacity() + held_.capacity();
+  bytes += (diag_.capacity() + sampled_step_.capacity() + stamp_.capacity()) * sizeof(double) + window_clamped_.capacity() + held_.capacity() +
+           stand_in_.capacity();
   auto row_bytes = [](const EmissionRow& r) { return (r.zeta.capacity() + r.c.capacity()) * sizeof(double); };
   bytes += levels_.capacity() * sizeof(EmissionRow) + level_tail_bias_.capacity() * sizeof(double);
   for (const EmissionRow& r : levels_) bytes += row_bytes(r);
@@ -889,7 +895,8 @@ int FairingWindow::emit_pending(std::span<FairedPose> out) {
   int count = 0;
   // The linear solver keeps no estimates between samples: solve the whole window once here.
   if (config_.solver == WindowSolver::Linear && first_unemitted() < n_) solve();
-  for (int i = first_unemitted(); i < n_; ++i) out[static_cast<std::size_t>(count++)] = emit(i);
+  for (int i = first_unemitted(); i < n_; ++i)
+    if (!stand_in_[static_cast<std::size_t>(i)]) out[static_cast<std::size_t>(count++)] = emit(i);
   n_ = 0;
   rot_.filling_moved = pos_.filling_moved = false;
   return count;
@@ -1018,7 +1025,7 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
     prepare(new_rate);
   }
   sampled_offset_ += gate_.sampled_step() - step;  // exactly 0 while the stamps are the sampled times
-  const double dt = verdict == GateVerdict::Accept ? step : 0.0;
+  double dt = verdict == GateVerdict::Accept ? step : 0.0;
   const bool had_last = have_time_;
   last_time_ = s.time;
   have_time_ = true;
@@ -1043,6 +1050,16 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
     rot_before_hold_ = learnt(rot_);
     pos_before_hold_ = learnt(pos_);
     before_hold_dt_ = dt;
+  }
+  // A step that lost a sample or a few (a radio tracker's lost packets) would be one step to the
+  // window, a jump in the motion's every difference: the lost ones are stood in for first. Not
+  // before a held sample (the line would lead to its prediction, and a release could not take them
+  // back).
+  if (const int lost = hold || !(dt > 0.0) ? 0 : lost_in_step(dt); lost > 0) {
+    const double each = dt / (lost + 1);
+    for (int j = 1; j <= lost; ++j)
+      count += stand_in(s, static_cast<double>(j) / (lost + 1), each, out.subspan(static_cast<std::size_t>(count)));
+    dt = each;
   }
   if (hold && !emit_measured) {
     Sample h = s;
@@ -1080,7 +1097,7 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   last_z_ = z_[static_cast<std::size_t>(n_ - 1)];
   last_p_ = s.position;
   last_has_position_ = s.has_position();
-  if (k >= 0) {
+  if (k >= 0 && !stand_in_[static_cast<std::size_t>(k)]) {
     out[static_cast<std::size_t>(count)] = emit(k);
     note_window_pose(out[static_cast<std::size_t>(count++)], s.time);
   }
@@ -1127,6 +1144,7 @@ void FairingWindow::slide(int count) {
   drop(stamp_);
   drop(z_);
   drop(held_);
+  drop(stand_in_);
   if (config_.solver == WindowSolver::Linear) {
     drop(zeta_);
     drop(residual_);
@@ -1201,6 +1219,47 @@ bool FairingWindow::hold_outliers(const Sample& s, double step, Quat& z, Vec3& p
   return held != 0;
 }
 
+// How many samples the step from the window's newest sample lost: j − 1 for a step within
+// kLostStepTolerance of j of the stream's intervals (2 ≤ j, at most kMaxLostInStep lost; the gate
+// calls a longer step a gap). Only where each sample of the window is one interval: the linear
+// solver's (whose emitted rows know nothing of the samples' times) with its rate known and no
+// continuity (a stand-in has no emitted pose to continue from), not gyro-aided (each step is
+// integrated from its own readings), not repeating, and not a clump's step (the stamps do not
+// give it).
+int FairingWindow::lost_in_step(double step) const {
+  if (config_.solver != WindowSolver::Linear || config_.continuity > 0.0 || !prepared_ || !(rate_ > 0.0) || n_ == 0 ||
+      aided_ || repeating_ || gate_.sampled_step() != step)
+    return 0;
+  // At rest a longer step moves nothing, and a stand-in would only bend the rest test's
+  // statistics (its slope's noise is white noise's; a stand-in's is its neighbours').
+  if (rot_.estimator.at_rest() && (!positions_ || pos_.estimator.at_rest())) return 0;
+  const double intervals = step * rate_;
+  const double j = std::round(intervals);
+  if (j < 2.0 || j > kMaxLostInStep + 1 || std::abs(intervals - j) > kLostStepTolerance) return 0;
+  return static_cast<int>(j) - 1;
+}
+
+// A sample lost before s, at fraction f of the step from the window's newest sample: on the
+// geodesic (and the position's line) between the two, taken into the window and faired as its
+// other samples, dt after the one before it. Emits what is due at the lag (never the stand-in).
+int FairingWindow::stand_in(const Sample& s, double f, double dt, std::span<FairedPose> out) {
+  const auto last = static_cast<std::size_t>(n_ - 1);
+  Sample lost = s;
+  lost.time = stamp_[last] + f * (s.time - stamp_[last]);
+  lost.orientation = z_[last].slerp(f, so3::aligned_to(s.orientation, z_[last])).normalized();
+  if (positions_) lost.position = zp_[last] + f * (s.position - zp_[last]);
+  append(lost);
+  ++counters_.lost;
+  const auto i = static_cast<std::size_t>(n_ - 1);
+  stand_in_[i] = 1;
+  since_stand_in_ = 0;
+  const int k = n_ - 1 - config_.lag;
+  linear_emission_estimate(k, dt);
+  if (k < 0 || stand_in_[static_cast<std::size_t>(k)]) return 0;
+  out[0] = emit(k);
+  return 1;
+}
+
 bool FairingWindow::gyro_aided(const Sample& s) const {
   // A non-finite reading is no reading: it would poison the window and the estimates.
   return config_.gyro.enabled && has_gyro_reading(s) && config_.solver == WindowSolver::Linear &&
@@ -1212,7 +1271,9 @@ void FairingWindow::append(const Sample& s) {
     positions_ = s.has_position();
     aided_ = gyro_aided(s);
     missing_gyro_run_ = 0;
+    since_stand_in_ = kNoStandIn;
   }
+  since_stand_in_ = std::min(since_stand_in_ + 1, kNoStandIn);
   if (aided_ && !gyro_aided(s)) {
     ++missing_gyro_run_;
     ++counters_.gyro_bridged;
@@ -1227,6 +1288,7 @@ void FairingWindow::append(const Sample& s) {
   sampled_step_[k] = gate_.sampled_step();
   window_clamped_[k] = 0;
   held_[k] = 0;
+  stand_in_[k] = 0;
   Quat z = s.orientation;
   if (n_ == 0) {
     if (z.w() < 0.0) z.coeffs() = -z.coeffs();

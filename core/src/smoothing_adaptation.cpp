@@ -185,7 +185,7 @@ double MotionNoiseEstimator::motion_floor(double fit_noise) const {
   return fit_noise;
 }
 
-bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::span<const Vec3> line_zeta) {
+bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::span<const Vec3> line_zeta, int measured) {
   const int n1 = static_cast<int>(zeta.size());  // differences available
   if (!(dt > 0.0)) return false;
   const bool was_ready = ready();
@@ -194,10 +194,11 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
   bool refreshed = false;
   if (e_.stopped_motion > 0.0 && ++e_.samples_since_stop >= capacity_) e_.stopped_motion = 0.0;
   if (n1 >= low_.order) {
-    update_median(e_.low, newest_difference(zeta, low_).norm(), dt);
+    // D^kθ spans k + 1 samples: one that reaches a stand-in measures its interpolation, not the noise.
+    if (measured > low_.order) update_median(e_.low, newest_difference(zeta, low_).norm(), dt);
     double s = std::exp(e_.low.log_median) * low_.sigma_per_median;
     if (high_.order > 0 && n1 >= high_.order) {
-      update_median(e_.high, newest_difference(zeta, high_).norm(), dt);
+      if (measured > high_.order) update_median(e_.high, newest_difference(zeta, high_).norm(), dt);
       // Once its exact start is complete: a median of a few values is not yet the noise's.
       if (e_.high.settled()) s = std::min(s, kNoiseOrderMargin * std::exp(e_.high.log_median) * high_.sigma_per_median);
     }

@@ -1,5 +1,6 @@
 // FairingWindow as a stream processor: lag and identity of the emitted poses, what the gate
 // does with bad and irregular input, gaps that restart the window, flush.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -308,12 +309,50 @@ TEST(FairingWindowStream, AStepOfMoreThanGapIntervalsRestartsUnlessItCatchesUpWi
   }
 }
 
+TEST(FairingWindowStream, SamplesLostWithinAStepAreStoodInForAndNeverEmitted) {
+  // At 100 Hz one sample is lost at 1 s and two at 2 s (steps of 2 and 3 intervals, no gap). The
+  // linear window stands in for them on the line between their neighbours: each input still comes
+  // out exactly once, in order, with its own time and sequence, and a step that lost samples says
+  // so. At a lag L the poses due as the stand-ins go in are emitted then: the push after two lost
+  // emits up to three (the L pending before the step, at most lost + 1).
+  const auto motion = noisy_motion(23, true, 300, 0.02, 5.0);
+  std::vector<Sample> in = samples_from(motion.noisy);
+  in.erase(in.begin() + 200, in.begin() + 202);
+  in.erase(in.begin() + 100);
+  for (const WindowSolver solver : kSolvers)
+    for (const int lag : {0, 1, 3}) {
+      SCOPED_TRACE(std::string(solver_name(solver)) + " lag=" + std::to_string(lag));
+      WindowConfig c = config(solver, lag);
+      c.rate_hz = 100.0;
+      FairingWindow w(c);
+      std::vector<int> counts;
+      const auto out = run(w, in, true, &counts);
+      ASSERT_EQ(out.size(), in.size());
+      for (std::size_t i = 0; i < in.size(); ++i) {
+        EXPECT_EQ(out[i].sequence, in[i].sequence) << i;
+        EXPECT_EQ(out[i].time, in[i].time) << i;
+        EXPECT_NEAR(out[i].step, i == 0 ? 0.0 : in[i].time - in[i - 1].time, 1e-12) << i;
+      }
+      EXPECT_EQ(w.counters().restarts, 0u);
+      EXPECT_EQ(w.counters().emitted, in.size());
+      // Only the linear solver stands in (the iterative ones take the step as one, as before).
+      EXPECT_EQ(w.counters().lost, solver == WindowSolver::Linear ? 3u : 0u);
+      if (lag == 0) {
+        for (std::size_t i = 0; i < in.size(); ++i) EXPECT_EQ(counts[i], 1) << i;
+      } else if (solver == WindowSolver::Linear) {
+        EXPECT_EQ(*std::max_element(counts.begin(), counts.end() - 1), std::min(lag, 3));  // the step that lost two
+      }
+    }
+}
+
 TEST(FairingWindowStream, JitteredTimestampsAreAcceptedAndTreatedAsEvenlySpaced) {
   const auto motion = noisy_motion(17, true, 200, 0.03, 5.0);
   const auto regular = samples_from(motion.noisy);
   std::vector<Sample> jittered = regular;
   std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> jitter(-0.004, 0.004);  // ±40 % of the 10 ms period
+  // ±35 % of the 10 ms period: no step reaches the 1.75 periods that a lost sample's would
+  // (kLostStepTolerance).
+  std::uniform_real_distribution<double> jitter(-0.0035, 0.0035);
   for (Sample& s : jittered) s.time += jitter(rng);
   for (WindowSolver solver : kSolvers) {
     SCOPED_TRACE(solver_name(solver));

@@ -99,6 +99,11 @@ bool emits_held_as_measured(const WindowConfig& config);
 inline constexpr double kMaxSmoothing = 1e10;
 // The shortest window window_s may give.
 inline constexpr int kMinWindowSamples = 8;
+// A step this close to a whole number j ≥ 2 of the stream's intervals (in intervals), and no gap,
+// lost j − 1 samples (a radio tracker's lost packets): the window stands in for them on the
+// line between their neighbours, at most kMaxLostInStep per step.
+inline constexpr double kLostStepTolerance = 0.25;
+inline constexpr int kMaxLostInStep = 8;
 // Candidate smoothing levels of the adaptation (a third of an octave of cutoff apart).
 inline constexpr int kMaxSmoothingLevels = 28;
 
@@ -124,6 +129,9 @@ struct WindowCounters {
   // Samples that repeated the measurement before, in a stream read faster than its source
   // updates (repeated_measurements.hpp): carried forward from the poses before, not faired.
   std::uint64_t repeated = 0;
+  // Samples lost within a step (one of two to four intervals with the default gate; a longer
+  // one is a gap): stood in for on the line between their neighbours, faired across, not emitted.
+  std::uint64_t lost = 0;
 };
 
 // What the engine is doing now: the rate and window it settled on and, per channel, what the
@@ -240,6 +248,8 @@ class FairingWindow {
   bool hold_outliers(const Sample& s, double step, Quat& z, Vec3& p, char& held);
   void put_held(const Quat& z, const Vec3& p, char held, double dt);
   void append(const Sample& s);
+  int lost_in_step(double step) const;
+  int stand_in(const Sample& s, double f, double dt, std::span<FairedPose> out);
   bool gyro_aided(const Sample& s) const;
   // What the rotation rows apply to: the measured increments ζ, or with a gyro their residual.
   const SlidingArray<Vec3>& rotation_increments() const { return aided_ ? residual_ : zeta_; }
@@ -375,6 +385,11 @@ class FairingWindow {
   SlidingArray<Vec3> dzp_;         // p_{j+1} − p_j (Linear)
   SlidingArray<Vec3> cp_;          // y_p,i − z_p,i of emitted samples (Linear)
   SlidingArray<char> window_clamped_;  // the window bound moved this sample during a solve
+  // A sample lost within a step, stood in for on the line between its neighbours (lost_in_step):
+  // faired as the window's others, never emitted, and its differences are no measure of noise.
+  SlidingArray<char> stand_in_;
+  static constexpr int kNoStandIn = 1 << 20;
+  int since_stand_in_ = kNoStandIn;  // samples appended since the newest stand-in (at most kNoStandIn: none lately)
   SlidingArray<char> held_;        // an outlier held (kHeldRotation, kHeldPosition): z_/zp_ hold the prediction, samples_ the measurement
   SlidingArray<Quat> y_;           // what was emitted (valid for emitted indices)
   SlidingArray<Vec3> zp_, xp_, yp_;

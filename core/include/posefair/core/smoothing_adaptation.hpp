@@ -29,6 +29,7 @@
 // a lot. Every input is per sample; the time constants are in seconds, so streams of any rate
 // behave alike. No allocation after construction.
 #include <array>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -97,7 +98,11 @@ class MotionNoiseEstimator {
   // line_zeta, when as long as zeta: the same differences on a chart, which the rest test's
   // line is fitted to instead (FairingWindow gives those of a rotation at rest: summed, the
   // increments ζ carry second-order terms that walk under heavy noise).
-  bool update(std::span<const Vec3> zeta, double dt, std::span<const Vec3> line_zeta = {});
+  // measured: how many of the newest samples were measured; the samples before them include one
+  // the window stood in for (FairingWindow::stand_in), and no difference that reaches it goes into
+  // the noise estimate.
+  bool update(std::span<const Vec3> zeta, double dt, std::span<const Vec3> line_zeta = {},
+              int measured = std::numeric_limits<int>::max());
   static constexpr double kMotionRefreshes = 25.0;  // motion fits per motion_time_s, at most
   // A stream at rest stays at rest until the line's mean square is this many times the
   // threshold. The window's slope is correlated over the whole window, so under noise alone a
