@@ -121,6 +121,10 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
                 static_cast<unsigned long long>(r.counters.emitted), static_cast<unsigned long long>(r.counters.clamped),
                 static_cast<unsigned long long>(r.counters.restarts), static_cast<unsigned long long>(r.counters.rate_changes),
                 static_cast<unsigned long long>(r.gate.dropped()), static_cast<unsigned long long>(r.gate.rejected()));
+    if (r.counters.lost > 0)
+      std::printf("lost     %llu samples lost within a step of a few intervals (not a gap), stood in for on the line between "
+                  "their neighbours and not emitted\n",
+                  static_cast<unsigned long long>(r.counters.lost));
     if (r.counters.repeated > 0)
       std::printf("repeats  %llu samples repeated the measurement before them (a source read faster than it updates), "
                   "carried forward from the poses before; %s\n",

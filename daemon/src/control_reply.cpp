@@ -208,6 +208,7 @@ std::string streams_member(const std::vector<StreamStats>& now, const std::vecto
                 .add("restarts", s.restarts)
                 .add("rate_changes", s.rate_changes)
                 .add("repeated", s.repeated)
+                .add("lost", s.lost)
                 .add("published", s.published)
                 .add("send_failures", s.send_failures)
                 .add("recorded", s.recorded)

@@ -526,6 +526,7 @@ bool Pipeline::stream_pass(Stream& s) {
   s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
   s.counters.rate_changes.store(w.rate_changes, std::memory_order_relaxed);
   s.counters.repeated.store(w.repeated, std::memory_order_relaxed);
+  s.counters.lost.store(w.lost, std::memory_order_relaxed);
   s.counters.gyro.bridged.store(w.gyro_bridged, std::memory_order_relaxed);
   store_engine_state(s.counters, s.window.state());
   if (s.gyro_pairing) {
@@ -709,6 +710,7 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.restarts = get(s.counters.restarts);
     st.rate_changes = get(s.counters.rate_changes);
     st.repeated = get(s.counters.repeated);
+    st.lost = get(s.counters.lost);
     st.gyro_bridged = get(s.counters.gyro.bridged);
     st.engine = load_engine_state(s.counters);
     st.publish_dropped = s.pose_ring.dropped();

@@ -142,6 +142,10 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
                     s.engine.repeating ? "the rate is the source's" : "not repeating now");
       lines.back() += buf;
     }
+    if (s.lost > 0) {  // lost packets: steps of a few intervals, not gaps (fairing_window.hpp, kLostStepTolerance)
+      std::snprintf(buf, sizeof buf, ", lost %" PRIu64 " (stood in for)", s.lost);
+      lines.back() += buf;
+    }
     if (s.raw_unfused > 0) {  // a raw IMU source without a fusion stage: say why nothing is faired
       std::snprintf(buf, sizeof buf, ", raw-only %" PRIu64 " (not faired: no orientation, no fusion stage)", s.raw_unfused);
       lines.back() += buf;

@@ -72,6 +72,16 @@ TEST(StatusReport, AChangeOfRateShowsAmongTheRestarts) {
   EXPECT_NE(json.find("\"restarts\":3,\"rate_changes\":1,"), std::string::npos) << json;
 }
 
+// Samples lost within a step (a lost packet, no gap) show once there are some.
+TEST(StatusReport, LostSamplesShowOnceThereAreSome) {
+  StreamStats s = stream(1, "head", 2000);
+  EXPECT_EQ(counter_lines({s}, {}, 0.0)[0].find("lost"), std::string::npos);
+  EXPECT_NE(streams_member({s}, {}, 1.0).find("\"lost\":0,"), std::string::npos);
+  s.lost = 37;
+  EXPECT_NE(counter_lines({s}, {}, 0.0)[0].find(", lost 37 (stood in for)"), std::string::npos) << counter_lines({s}, {}, 0.0)[0];
+  EXPECT_NE(streams_member({s}, {}, 1.0).find("\"lost\":37,"), std::string::npos) << streams_member({s}, {}, 1.0);
+}
+
 // A source read faster than it updates (repeated_measurements.hpp): its repeats carried forward
 // show in the counter line and the control reply once there are some, and while the stream
 // repeats, STATUS= gives the source's rate the window runs at.

@@ -29,6 +29,7 @@ struct StreamCounters {
   std::atomic<std::uint64_t> restarts{0};         // windows restarted after a gap or a change of rate
   std::atomic<std::uint64_t> rate_changes{0};     // of which for a change of the measured rate
   std::atomic<std::uint64_t> repeated{0};         // samples that repeated the measurement before, carried forward (repeated_measurements.hpp)
+  std::atomic<std::uint64_t> lost{0};             // samples lost within a step, stood in for in the window (not a gap)
   std::atomic<std::uint64_t> bridged_gaps{0};     // input gaps filled on the spline ([stream.spline] bridge_gap)
   std::atomic<std::uint64_t> bridged_samples{0};  // samples made for them
   std::atomic<std::uint64_t> unbridged_gaps{0};   // gaps passed through: longer than max_gap, or ended by a read too long to wait
@@ -91,6 +92,7 @@ struct StreamStats {
   std::uint64_t received = 0, ring_dropped = 0, rejected = 0, out_of_order = 0, emitted = 0, clamped = 0, restarts = 0;
   std::uint64_t rate_changes = 0;  // of the restarts, for a change of the measured rate
   std::uint64_t repeated = 0;  // samples that repeated the measurement before, carried forward (repeated_measurements.hpp)
+  std::uint64_t lost = 0;  // samples lost within a step (a lost packet), stood in for in the window (not a gap)
   std::uint64_t outliers_held = 0, outliers_released = 0;  // the outlier guard (outlier_guard.hpp)
   std::uint64_t gyro_bridged = 0;  // gyro readings missing from an aided window, bridged (no restart)
   std::uint64_t raw_unfused = 0;  // raw-only samples not faired (no orientation, no fusion stage); still recorded
