@@ -89,11 +89,11 @@ std::function<Quat(double)> walk(std::mt19937_64& rng, double seconds, double dt
   };
 }
 
-// Removes runs of 4 to 12 samples from the stream, starting at times a Poisson process of
-// `per_s` a second puts them (from its first sample on), with a sample kept between two.
-void drop_runs(QualitySequence& s, double per_s, std::mt19937_64 rng) {
+// Removes runs of `shortest` to `longest` samples from the stream, starting at times a Poisson
+// process of `per_s` a second puts them (from its first sample on), with a sample kept between two.
+void drop_runs(QualitySequence& s, double per_s, int shortest, int longest, std::mt19937_64 rng) {
   std::exponential_distribution<double> until_next(per_s);
-  std::uniform_int_distribution<int> run(4, 12);
+  std::uniform_int_distribution<int> run(shortest, longest);
   double next = s.input.time.front() + until_next(rng);
   int lost = 0;
   bool kept_one = true;  // a sample kept since the last run (two runs back to back are one)
@@ -127,7 +127,7 @@ std::string GeneratedStreamSpec::name() const {
     std::snprintf(b, sizeof b, "%s-%gHz-noise%g-from%gHz-%s", motion.c_str(), rate_hz, noise, source_hz, resampling.c_str());
   else
     std::snprintf(b, sizeof b, "%s-%gHz-noise%g", motion.c_str(), rate_hz, noise);
-  return dropouts_per_s > 0.0 ? std::string(b) + "-dropouts" : std::string(b);
+  return std::string(b) + (dropouts_per_s > 0.0 ? "-dropouts" : "") + (lost_per_s > 0.0 ? "-lost" : "");
 }
 
 std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick) {
@@ -144,13 +144,16 @@ std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick) {
     for (const char* resampling : {"hold", "linear"}) out.push_back({motion, 250.0, 0.01, 20.0, 60.0, resampling});
   for (const char* motion : {"still", "sway", "turns", "walk"})
     for (double noise : {0.002, 0.01}) out.push_back({motion, 120.0, noise, 20.0, 0.0, {}, 1.0});
+  for (const char* motion : {"still", "sway", "turns", "walk"})
+    for (double noise : {0.002, 0.01}) out.push_back({motion, 60.0, noise, 20.0, 0.0, {}, 0.0, 5.0});
   return out;
 }
 
 QualitySequence generated_stream(const GeneratedStreamSpec& spec) {
-  // With dropouts, the same stream as without them, less the runs it loses.
+  // With dropouts or lost packets, the same stream as without them, less the samples it loses.
   GeneratedStreamSpec whole = spec;
   whole.dropouts_per_s = 0.0;
+  whole.lost_per_s = 0.0;
   std::mt19937_64 rng(seed_of(whole.name()));
   const double dense_rate = std::max(8.0 * spec.rate_hz, 2000.0);
   std::function<Quat(double)> truth_at;
@@ -207,7 +210,8 @@ QualitySequence generated_stream(const GeneratedStreamSpec& spec) {
   s.truth = TruthTrack(std::move(time), std::move(orientation), 1.5 / dense_rate);
   s.use.assign(n, 1);
   for (std::size_t i = 0; i < n && static_cast<double>(i) < kWarmUpSeconds * spec.rate_hz; ++i) s.use[i] = 0;
-  if (spec.dropouts_per_s > 0.0) drop_runs(s, spec.dropouts_per_s, std::mt19937_64(seed_of(spec.name()) + 1));
+  if (spec.dropouts_per_s > 0.0) drop_runs(s, spec.dropouts_per_s, 4, 12, std::mt19937_64(seed_of(spec.name()) + 1));
+  if (spec.lost_per_s > 0.0) drop_runs(s, spec.lost_per_s, 1, 2, std::mt19937_64(seed_of(spec.name()) + 1));
   return s;
 }
 

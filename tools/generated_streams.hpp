@@ -32,14 +32,19 @@ struct GeneratedStreamSpec {
   // Runs of 4 to 12 samples lost, this many a second on average (a radio tracker's dropped
   // packets; each run is a gap that restarts the window): 0, none.
   double dropouts_per_s = 0.0;
-  // "sway-100Hz-noise0.01", "sway-250Hz-noise0.01-from60Hz-hold", "turns-120Hz-noise0.01-dropouts"
+  // One or two samples lost, this many times a second on average (a radio tracker's lost
+  // packets; each a step of two or three intervals, no gap): 0, none.
+  double lost_per_s = 0.0;
+  // "sway-100Hz-noise0.01", "sway-250Hz-noise0.01-from60Hz-hold", "turns-120Hz-noise0.01-dropouts",
+  // "walk-60Hz-noise0.01-lost"
   std::string name() const;
 };
 
 // Every motion × rate (10, 30, 60, 120, 250, 1000 Hz) × noise (0.0002: a clean stream, as a good
 // VR tracker's; 0.002, 0.01, 0.04), and still,
 // sway, turns and walk measured at 60 Hz under noise 0.01, resampled to 250 Hz both ways, and at
-// 120 Hz under noise 0.002 and 0.01 with dropouts (one a second); quick:
+// 120 Hz under noise 0.002 and 0.01 with dropouts (one a second), and at 60 Hz under the same with
+// lost packets (five a second); quick:
 // sway and turns at 30 and 100 Hz, noise 0.01, 5 s.
 std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick);
 

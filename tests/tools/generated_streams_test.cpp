@@ -50,10 +50,10 @@ TEST(GeneratedStreams, ALinearStreamSlerpsBetweenTheSourceMeasurements) {
   EXPECT_EQ(changes(linear), 4999);
 }
 
-TEST(GeneratedStreams, AStreamWithDropoutsLosesRunsOfFourToTwelveSamples) {
-  const QualitySequence full = generated_stream({"turns", 120.0, 0.01, 20.0, 0.0, {}});
-  const QualitySequence dropped = generated_stream({"turns", 120.0, 0.01, 20.0, 0.0, {}, 1.0});
-  EXPECT_EQ(dropped.name, "turns-120Hz-noise0.01-dropouts");
+// What is kept is the stream without losses, sample for sample; what is lost comes in runs of
+// `shortest` to `longest` samples, between `fewest` and `most` of them.
+void expect_runs_lost(const QualitySequence& full, const QualitySequence& dropped, std::size_t shortest, std::size_t longest,
+                      int fewest, int most) {
   ASSERT_EQ(dropped.input.size(), dropped.use.size());
   // What is kept is the stream without dropouts, sample for sample; what is lost comes in runs.
   std::size_t j = 0;
@@ -68,14 +68,27 @@ TEST(GeneratedStreams, AStreamWithDropoutsLosesRunsOfFourToTwelveSamples) {
     const std::size_t lost = j - from;
     if (lost > 0) {
       ++runs;
-      EXPECT_GE(lost, 4u);
-      EXPECT_LE(lost, 12u);
+      EXPECT_GE(lost, shortest);
+      EXPECT_LE(lost, longest);
     }
     ++j;
   }
-  // One a second on average over 20 s.
-  EXPECT_GE(runs, 8);
-  EXPECT_LE(runs, 35);
+  EXPECT_GE(runs, fewest);
+  EXPECT_LE(runs, most);
+}
+
+TEST(GeneratedStreams, AStreamWithDropoutsLosesRunsOfFourToTwelveSamples) {
+  const QualitySequence full = generated_stream({"turns", 120.0, 0.01, 20.0, 0.0, {}});
+  const QualitySequence dropped = generated_stream({"turns", 120.0, 0.01, 20.0, 0.0, {}, 1.0});
+  EXPECT_EQ(dropped.name, "turns-120Hz-noise0.01-dropouts");
+  expect_runs_lost(full, dropped, 4, 12, 8, 35);  // one a second on average over 20 s
+}
+
+TEST(GeneratedStreams, AStreamThatLosesPacketsLosesOneOrTwoSamplesAtATime) {
+  const QualitySequence full = generated_stream({"walk", 60.0, 0.01, 20.0, 0.0, {}});
+  const QualitySequence lossy = generated_stream({"walk", 60.0, 0.01, 20.0, 0.0, {}, 0.0, 5.0});
+  EXPECT_EQ(lossy.name, "walk-60Hz-noise0.01-lost");
+  expect_runs_lost(full, lossy, 1, 2, 70, 130);  // five a second on average over 20 s
 }
 
 TEST(GeneratedStreams, AnUnknownResamplingIsAnError) {
