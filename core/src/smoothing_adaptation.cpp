@@ -202,7 +202,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
       // Once its exact start is complete: a median of a few values is not yet the noise's.
       if (e_.high.settled()) s = std::min(s, kNoiseOrderMargin * std::exp(e_.high.log_median) * high_.sigma_per_median);
     }
-    e_.noise_var = s * s;
+    if (e_.low.count > 0) e_.noise_var = s * s;  // (none yet where only stand-ins' differences came)
   }
   // The noise each fit lets through, at the noise estimate just updated.
   const double fit_noise = e_.noise_var * fit_noise_gain_;
