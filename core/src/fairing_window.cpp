@@ -1219,20 +1219,23 @@ bool FairingWindow::hold_outliers(const Sample& s, double step, Quat& z, Vec3& p
   return held != 0;
 }
 
+// Whether the window stands in for samples lost now: where each of its samples is one interval,
+// the linear solver's (whose emitted rows know nothing of the samples' times) with its rate
+// known and no continuity (a stand-in has no emitted pose to continue from), not gyro-aided (each
+// step is integrated from its own readings), not repeating; and not at rest, where a longer step
+// moves nothing and a stand-in would only bend the rest test's statistics (its slope's noise is
+// white noise's; a stand-in's is its neighbours').
+bool FairingWindow::stands_in() const {
+  return config_.solver == WindowSolver::Linear && config_.continuity == 0.0 && prepared_ && rate_ > 0.0 && n_ > 0 &&
+         !aided_ && !repeating_ && !(rot_.estimator.at_rest() && (!positions_ || pos_.estimator.at_rest()));
+}
+
 // How many samples the step from the window's newest sample lost: j − 1 for a step within
 // kLostStepTolerance of j of the stream's intervals (2 ≤ j, at most kMaxLostInStep lost; the gate
-// calls a longer step a gap). Only where each sample of the window is one interval: the linear
-// solver's (whose emitted rows know nothing of the samples' times) with its rate known and no
-// continuity (a stand-in has no emitted pose to continue from), not gyro-aided (each step is
-// integrated from its own readings), not repeating, and not a clump's step (the stamps do not
-// give it).
+// calls a longer step a gap), where the window stands in for them; not on a clump's step (the
+// stamps do not give it).
 int FairingWindow::lost_in_step(double step) const {
-  if (config_.solver != WindowSolver::Linear || config_.continuity > 0.0 || !prepared_ || !(rate_ > 0.0) || n_ == 0 ||
-      aided_ || repeating_ || gate_.sampled_step() != step)
-    return 0;
-  // At rest a longer step moves nothing, and a stand-in would only bend the rest test's
-  // statistics (its slope's noise is white noise's; a stand-in's is its neighbours').
-  if (rot_.estimator.at_rest() && (!positions_ || pos_.estimator.at_rest())) return 0;
+  if (!stands_in() || gate_.sampled_step() != step) return 0;
   const double intervals = step * rate_;
   const double j = std::round(intervals);
   if (j < 2.0 || j > kMaxLostInStep + 1 || std::abs(intervals - j) > kLostStepTolerance) return 0;

@@ -248,6 +248,7 @@ class FairingWindow {
   bool hold_outliers(const Sample& s, double step, Quat& z, Vec3& p, char& held);
   void put_held(const Quat& z, const Vec3& p, char held, double dt);
   void append(const Sample& s);
+  bool stands_in() const;
   int lost_in_step(double step) const;
   int stand_in(const Sample& s, double f, double dt, std::span<FairedPose> out);
   bool gyro_aided(const Sample& s) const;
