@@ -1055,6 +1055,7 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   // window, a jump in the motion's every difference: the lost ones are stood in for first. Not
   // before a held sample (the line would lead to its prediction, and a release could not take them
   // back).
+  note_step_grid(dt);
   if (const int lost = hold || !(dt > 0.0) ? 0 : lost_in_step(dt); lost > 0) {
     const double each = dt / (lost + 1);
     for (int j = 1; j <= lost; ++j)
@@ -1222,12 +1223,26 @@ bool FairingWindow::hold_outliers(const Sample& s, double step, Quat& z, Vec3& p
 // Whether the window stands in for samples lost now: where each of its samples is one interval,
 // the linear solver's (whose emitted rows know nothing of the samples' times) with its rate
 // known and no continuity (a stand-in has no emitted pose to continue from), not gyro-aided (each
-// step is integrated from its own readings), not repeating; and not at rest, where a longer step
+// step is integrated from its own readings), not repeating; not at rest, where a longer step
 // moves nothing and a stand-in would only bend the rest test's statistics (its slope's noise is
-// white noise's; a stand-in's is its neighbours').
+// white noise's; a stand-in's is its neighbours'); and not while the stamps jitter
+// (note_step_grid).
 bool FairingWindow::stands_in() const {
   return config_.solver == WindowSolver::Linear && config_.continuity == 0.0 && prepared_ && rate_ > 0.0 && n_ > 0 &&
-         !aided_ && !repeating_ && !(rot_.estimator.at_rest() && (!positions_ || pos_.estimator.at_rest()));
+         !aided_ && !repeating_ && !(rot_.estimator.at_rest() && (!positions_ || pos_.estimator.at_rest())) &&
+         !(last_time_ - off_grid_time_ < kOffGridMemory);
+}
+
+// A step off the grid of whole intervals (shorter than one, or between two whole numbers by more
+// than kLostStepTolerance; or a clump's) says the stamps jitter: receive times, where a long step
+// is as likely a late sample, with an early one after it, as a lost one. For kOffGridMemory after
+// one, nothing is stood in for.
+void FairingWindow::note_step_grid(double step) {
+  if (!(rate_ > 0.0) || !(step > 0.0)) return;
+  const double intervals = step * rate_;
+  if (intervals < 1.0 - kLostStepTolerance || std::abs(intervals - std::round(intervals)) > kLostStepTolerance ||
+      gate_.sampled_step() != step)
+    off_grid_time_ = last_time_;
 }
 
 // How many samples the step from the window's newest sample lost: j − 1 for a step within

@@ -345,14 +345,32 @@ TEST(FairingWindowStream, SamplesLostWithinAStepAreStoodInForAndNeverEmitted) {
     }
 }
 
+TEST(FairingWindowStream, ALateSampleWithAnEarlyOneAfterItIsNotTakenForALostOne) {
+  // Receive times: every 25th sample of a 100 Hz stream arrives 9.5 ms late and the next one just
+  // after it. The late one's step (1.95 periods) is a lost sample's to look at; the short step
+  // after it says the stamps jitter, and for kOffGridMemory after that nothing is stood in for.
+  // Only the first late sample, before any short step, is taken for a loss.
+  const auto motion = noisy_motion(29, false, 600, 0.02);
+  std::vector<Sample> in = samples_from(motion.noisy);
+  for (std::size_t i = 50; i < in.size(); i += 25) in[i].time += 0.0095;
+  WindowConfig c = config(WindowSolver::Linear, 0);
+  c.rate_hz = 100.0;
+  FairingWindow w(c);
+  const auto out = run(w, in);
+  ASSERT_EQ(out.size(), in.size());
+  EXPECT_EQ(w.counters().restarts, 0u);
+  EXPECT_EQ(w.counters().lost, 1u);  // of 22 late samples
+}
+
 TEST(FairingWindowStream, JitteredTimestampsAreAcceptedAndTreatedAsEvenlySpaced) {
   const auto motion = noisy_motion(17, true, 200, 0.03, 5.0);
   const auto regular = samples_from(motion.noisy);
   std::vector<Sample> jittered = regular;
   std::mt19937_64 rng(5);
-  // ±35 % of the 10 ms period: no step reaches the 1.75 periods that a lost sample's would
-  // (kLostStepTolerance).
-  std::uniform_real_distribution<double> jitter(-0.0035, 0.0035);
+  // ±40 % of the 10 ms period: a step now and then reaches the 1.75 periods a lost sample's would
+  // (kLostStepTolerance), but the steps shorter than one period say the stamps jitter, and
+  // nothing is stood in for (kOffGridMemory).
+  std::uniform_real_distribution<double> jitter(-0.004, 0.004);
   for (Sample& s : jittered) s.time += jitter(rng);
   for (WindowSolver solver : kSolvers) {
     SCOPED_TRACE(solver_name(solver));
@@ -362,6 +380,7 @@ TEST(FairingWindowStream, JitteredTimestampsAreAcceptedAndTreatedAsEvenlySpaced)
     EXPECT_EQ(w.gate_counters().accepted, jittered.size());
     EXPECT_EQ(w.gate_counters().dropped() + w.gate_counters().rejected(), 0u);
     EXPECT_EQ(w.counters().restarts, 0u);
+    EXPECT_EQ(w.counters().lost, 0u);
     ASSERT_EQ(out.size(), expected.size());
     for (std::size_t i = 0; i < out.size(); ++i) {
       EXPECT_EQ(out[i].time, jittered[i].time);

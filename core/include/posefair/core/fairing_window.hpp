@@ -104,6 +104,9 @@ inline constexpr int kMinWindowSamples = 8;
 // line between their neighbours, at most kMaxLostInStep per step.
 inline constexpr double kLostStepTolerance = 0.25;
 inline constexpr int kMaxLostInStep = 8;
+// Nothing is stood in for this long (seconds) after a step off the grid of whole intervals: the
+// stamps jitter, and a long step may be a late sample (FairingWindow::note_step_grid).
+inline constexpr double kOffGridMemory = 2.0;
 // Candidate smoothing levels of the adaptation (a third of an octave of cutoff apart).
 inline constexpr int kMaxSmoothingLevels = 28;
 
@@ -250,6 +253,7 @@ class FairingWindow {
   void append(const Sample& s);
   bool stands_in() const;
   int lost_in_step(double step) const;
+  void note_step_grid(double step);
   int stand_in(const Sample& s, double f, double dt, std::span<FairedPose> out);
   bool gyro_aided(const Sample& s) const;
   // What the rotation rows apply to: the measured increments ζ, or with a gyro their residual.
@@ -391,6 +395,7 @@ class FairingWindow {
   SlidingArray<char> stand_in_;
   static constexpr int kNoStandIn = 1 << 20;
   int since_stand_in_ = kNoStandIn;  // samples appended since the newest stand-in (at most kNoStandIn: none lately)
+  double off_grid_time_ = -std::numeric_limits<double>::infinity();  // the newest step off the grid of intervals
   SlidingArray<char> held_;        // an outlier held (kHeldRotation, kHeldPosition): z_/zp_ hold the prediction, samples_ the measurement
   SlidingArray<Quat> y_;           // what was emitted (valid for emitted indices)
   SlidingArray<Vec3> zp_, xp_, yp_;
