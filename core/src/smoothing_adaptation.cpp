@@ -142,9 +142,18 @@ void MotionNoiseEstimator::update_median(Estimates::LengthMedian& m, double leng
     m.log_median = std::log(upper_median(std::span(sorted).first(static_cast<std::size_t>(m.count))));
   } else {
     // Stochastic approximation of the median in log space: a step up when above, down when
-    // below; its time constant is about 1/(2·step) samples.
-    const double step = std::min(0.5, 0.5 * dt / settings_.noise_time_s);
-    m.log_median += std::log(length) > m.log_median ? step : -step;
+    // below; its time constant is about 1/(2·step) samples. A long run on one side, or a short one
+    // far from it, is a noise that changed its level: the step doubles with each length beyond
+    // (kNoiseRunSamples, kNoiseFarSamples).
+    const double from_median = std::log(length) - m.log_median;
+    const bool above = from_median > 0.0;
+    m.run = above ? std::max(m.run, 0) + 1 : std::min(m.run, 0) - 1;
+    const double far = std::log(kNoiseFarFactor);
+    m.far_run = from_median > far ? std::max(m.far_run, 0) + 1 : from_median < -far ? std::min(m.far_run, 0) - 1 : 0;
+    double step = std::min(0.5, 0.5 * dt / settings_.noise_time_s);
+    const int beyond = std::max(std::abs(m.run) - kNoiseRunSamples, std::abs(m.far_run) - kNoiseFarSamples);
+    if (beyond > 0) step = std::max(step, std::min(kNoiseRunStepCap, std::ldexp(step, std::min(beyond, 60))));
+    m.log_median += above ? step : -step;
   }
 }
 

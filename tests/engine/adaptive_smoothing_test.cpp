@@ -1106,6 +1106,45 @@ TEST(Adaptation, AStandInForALostSampleIsNoMeasureOfTheNoise) {
   }
 }
 
+TEST(Adaptation, ANoiseThatChangesItsLevelIsFollowedSoon) {
+  // A tracker whose noise rises sixfold at 8 s (a marker half hidden), or falls as much: with the
+  // median's fixed step the estimate followed by a factor e^(1/4) a second, and a second after
+  // the change it was 0.21–0.22 of the risen noise and 4.7–4.8 times the fallen one, at 60 and
+  // 250 Hz. Now the step grows once the lengths run on one side (kNoiseRunSamples) or stand far
+  // from the median (kNoiseFarSamples): 0.59–0.72 of the risen noise, 1.14–1.42 times the fallen
+  // one. The steady noise before the change is read as before.
+  const auto sway = [](double t) {
+    return so3::from_rotation_vector(Vec3(0.3 * std::sin(2.0 * std::numbers::pi * 0.4 * t),
+                                          0.2 * std::sin(2.0 * std::numbers::pi * 0.27 * t + 1.0), 0.0));
+  };
+  for (const double rate : {60.0, 250.0}) {
+    for (const bool rising : {true, false}) {
+      SCOPED_TRACE(std::to_string(rate) + " Hz, " + (rising ? "rising" : "falling"));
+      const double before = rising ? 0.002 : 0.012, after = rising ? 0.012 : 0.002;
+      std::mt19937_64 rng(5);
+      std::normal_distribution<double> unit(0.0, 1.0);
+      Stream s;
+      for (int i = 0; i < static_cast<int>(9.0 * rate); ++i) {
+        const double t = i / rate, sigma = t < 8.0 ? before : after;
+        s.input.time.push_back(t);
+        s.truth.push_back(sway(t));
+        s.input.orientation.push_back(s.truth.back() *
+                                      so3::from_rotation_vector(sigma * Vec3(unit(rng), unit(rng), unit(rng))));
+      }
+      double at_7 = 0.0, at_9 = 0.0;
+      each_pose(s, WindowConfig{}, [&](std::size_t i, const FairedPose&, const FairingWindow& w) {
+        (s.input.time[i] < 7.0 ? at_7 : at_9) = w.state().rotation.noise;
+      });
+      // Reported as the RMS rotation angle of the noise: √3 σ.
+      EXPECT_NEAR(at_7 / (std::sqrt(3.0) * before), 1.0, 0.15);
+      if (rising)
+        EXPECT_GT(at_9 / (std::sqrt(3.0) * after), 0.5);
+      else
+        EXPECT_LT(at_9 / (std::sqrt(3.0) * after), 1.6);
+    }
+  }
+}
+
 TEST(Adaptation, AnOutlierAtRestIsNotTakenForAMotion) {
   // A still tracker with glitches (1% of its samples 0.2 rad off): a glitch's fit stands far
   // over the noise too, but only while it enters the span, so the onset rule above must not let

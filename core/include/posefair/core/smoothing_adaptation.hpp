@@ -179,6 +179,20 @@ class MotionNoiseEstimator {
   // their sampling spread, and the smaller of the two is biased low (taken plainly, still
   // streams, whose rest test weighs the slope against σ, lost 2–17% of their gain).
   static constexpr double kNoiseOrderMargin = 1.1;
+  // A noise that changes its level (a tracker losing sight of a marker, a camera in low light)
+  // puts every length on one side of the tracked median, and the median's fixed step follows it
+  // by a factor e^(1/4) a second: six times the noise took 7 s. After this many lengths in a row
+  // on one side, or kNoiseFarSamples in a row more than kNoiseFarFactor times above or below it,
+  // the step doubles with each further one, up to kNoiseRunStepCap (in log σ per sample), until
+  // the run ends. Under a steady noise the lengths of overlapping differences run together: with
+  // runs of 8 or 16 the estimate wandered, still streams left rest by chance and lost up to 78%
+  // (8) of their gain; with far runs of 4 or 5, up to 4%. With these, nothing in `posefair bench
+  // streams` or the quality benchmark moved by more than 1% but three streams at 1 kHz
+  // (docs/engine.md, "A noise that changes its level").
+  static constexpr int kNoiseRunSamples = 32;
+  static constexpr int kNoiseFarSamples = 6;
+  static constexpr double kNoiseFarFactor = 2.0;
+  static constexpr double kNoiseRunStepCap = 0.1;
 
   // What the estimator has learnt from the stream (its weights aside, which configure() sets):
   // small and copyable, so that a window can put it back as it was before a sample it took
@@ -190,6 +204,8 @@ class MotionNoiseEstimator {
       std::array<double, 15> first_lengths{};
       int count = 0;
       double log_median = 0.0;
+      int run = 0;  // lengths in a row above the median (> 0) or below it (< 0)
+      int far_run = 0;  // lengths in a row kNoiseFarFactor times above it (> 0) or below (< 0)
       bool settled() const { return count >= static_cast<int>(first_lengths.size()); }
     };
     LengthMedian low, high;
