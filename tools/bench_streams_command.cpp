@@ -91,7 +91,7 @@ int bench_streams(const std::string& out_dir, bool quick) {
     return exit_code(ErrorKind::CantCreate);
   }
   csv << "stream,motion,rate_hz,noise,raw,default,one_euro_default,best_posefair,best_posefair_config,best_one_euro,"
-         "best_one_euro_config,raw_jitter,default_jitter,source_hz,resampling,dropouts_per_s,lost_per_s\n";
+         "best_one_euro_config,raw_jitter,default_jitter,source_hz,resampling,dropouts_per_s,lost_per_s,burst_factor\n";
   std::vector<StreamRow> rows;
   for (const GeneratedStreamSpec& spec : generated_stream_specs(quick)) {
     rows.push_back(run_stream(spec));
@@ -99,14 +99,14 @@ int bench_streams(const std::string& out_dir, bool quick) {
     csv << spec.name() << ',' << spec.motion << ',' << spec.rate_hz << ',' << spec.noise << ',' << r.raw << ',' << r.fair << ','
         << r.one_euro << ',' << r.best_fair.error << ",\"" << r.best_fair.config << "\"," << r.best_one_euro.error << ",\""
         << r.best_one_euro.config << "\"," << r.raw_jitter << ',' << r.fair_jitter << ',' << spec.source_hz << ',' << spec.resampling
-        << ',' << spec.dropouts_per_s << ',' << spec.lost_per_s << '\n';
+        << ',' << spec.dropouts_per_s << ',' << spec.lost_per_s << ',' << spec.burst_factor << '\n';
   }
 
   std::printf("## Generated streams: the defaults where nothing was tuned\n\n");
   std::printf("%zu streams (%s), error (a) in rad, RMS at the delivery time, the first second left out; percentages against\n"
               "raw. Best on the stream: each family's lowest error among its configurations at lag 0, picked on that stream\n"
               "itself (posefair: m × 10 smoothings × 2 windows; One Euro: 80), an upper bound on what tuning it could do.\n\n",
-              rows.size(), quick ? "--quick" : "5 motions × 6 rates × 4 noise levels, 4 motions measured at 60 Hz, resampled to 250 Hz 2 ways, 4 motions at 120 Hz under 2 noise levels with dropouts, and the same at 60 Hz with lost packets");
+              rows.size(), quick ? "--quick" : "5 motions × 6 rates × 4 noise levels, 4 motions measured at 60 Hz, resampled to 250 Hz 2 ways, 4 motions at 120 Hz under 2 noise levels with dropouts, the same at 60 Hz with lost packets, and 4 motions at 60 and 250 Hz with noise bursts");
   std::printf("| stream | raw | posefair default | best posefair on the stream | default against it | One Euro default | best One Euro on the stream | default against it |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
   for (const StreamRow& r : rows)

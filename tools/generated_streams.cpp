@@ -20,6 +20,8 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kWarmUpSeconds = 1.0;
+// Noise bursts: a second long, from kBurstFrom seconds into every kBurstEvery.
+constexpr double kBurstEvery = 5.0, kBurstFrom = 3.0;
 
 // FNV-1a of the name: the same seed on every platform (std::hash is not).
 std::uint64_t seed_of(const std::string& name) {
@@ -127,7 +129,8 @@ std::string GeneratedStreamSpec::name() const {
     std::snprintf(b, sizeof b, "%s-%gHz-noise%g-from%gHz-%s", motion.c_str(), rate_hz, noise, source_hz, resampling.c_str());
   else
     std::snprintf(b, sizeof b, "%s-%gHz-noise%g", motion.c_str(), rate_hz, noise);
-  return std::string(b) + (dropouts_per_s > 0.0 ? "-dropouts" : "") + (lost_per_s > 0.0 ? "-lost" : "");
+  return std::string(b) + (dropouts_per_s > 0.0 ? "-dropouts" : "") + (lost_per_s > 0.0 ? "-lost" : "") +
+         (burst_factor > 0.0 ? "-bursts" : "");
 }
 
 std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick) {
@@ -146,14 +149,18 @@ std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick) {
     for (double noise : {0.002, 0.01}) out.push_back({motion, 120.0, noise, 20.0, 0.0, {}, 1.0});
   for (const char* motion : {"still", "sway", "turns", "walk"})
     for (double noise : {0.002, 0.01}) out.push_back({motion, 60.0, noise, 20.0, 0.0, {}, 0.0, 5.0});
+  for (const char* motion : {"still", "sway", "turns", "walk"})
+    for (double rate : {60.0, 250.0}) out.push_back({motion, rate, 0.002, 20.0, 0.0, {}, 0.0, 0.0, 5.0});
   return out;
 }
 
 QualitySequence generated_stream(const GeneratedStreamSpec& spec) {
-  // With dropouts or lost packets, the same stream as without them, less the samples it loses.
+  // With dropouts or lost packets, the same stream as without them, less the samples it loses;
+  // with noise bursts, the same stream with its noise scaled in them.
   GeneratedStreamSpec whole = spec;
   whole.dropouts_per_s = 0.0;
   whole.lost_per_s = 0.0;
+  whole.burst_factor = 0.0;
   std::mt19937_64 rng(seed_of(whole.name()));
   const double dense_rate = std::max(8.0 * spec.rate_hz, 2000.0);
   std::function<Quat(double)> truth_at;
@@ -185,7 +192,9 @@ QualitySequence generated_stream(const GeneratedStreamSpec& spec) {
   std::vector<Quat> measured;
   for (std::size_t i = 0; static_cast<double>(i) / measured_hz <= spec.seconds + 1.0 / measured_hz; ++i) {
     const double t = static_cast<double>(i) / measured_hz;
-    measured.push_back((truth_at(t) * so3::exp(random_offset(rng, spec.noise))).normalized());
+    const double in_burst = std::fmod(t, kBurstEvery) >= kBurstFrom && std::fmod(t, kBurstEvery) < kBurstFrom + 1.0;
+    const Vec3 offset = random_offset(rng, spec.noise);
+    measured.push_back((truth_at(t) * so3::exp(spec.burst_factor > 0.0 && in_burst ? spec.burst_factor * offset : offset)).normalized());
   }
   for (std::size_t i = 0; i < n; ++i) {
     const double t = static_cast<double>(i) / spec.rate_hz;

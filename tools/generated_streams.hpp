@@ -35,8 +35,11 @@ struct GeneratedStreamSpec {
   // One or two samples lost, this many times a second on average (a radio tracker's lost
   // packets; each a step of two or three intervals, no gap): 0, none.
   double lost_per_s = 0.0;
+  // The noise this many times larger for one second in every five, from 3 s on (a marker half
+  // hidden, a camera in low light; the same stream as without them, its noise scaled): 0, none.
+  double burst_factor = 0.0;
   // "sway-100Hz-noise0.01", "sway-250Hz-noise0.01-from60Hz-hold", "turns-120Hz-noise0.01-dropouts",
-  // "walk-60Hz-noise0.01-lost"
+  // "walk-60Hz-noise0.01-lost", "still-60Hz-noise0.002-bursts"
   std::string name() const;
 };
 
@@ -44,7 +47,8 @@ struct GeneratedStreamSpec {
 // VR tracker's; 0.002, 0.01, 0.04), and still,
 // sway, turns and walk measured at 60 Hz under noise 0.01, resampled to 250 Hz both ways, and at
 // 120 Hz under noise 0.002 and 0.01 with dropouts (one a second), and at 60 Hz under the same with
-// lost packets (five a second); quick:
+// lost packets (five a second), and at 60 and 250 Hz under noise 0.002 with bursts of five times
+// the noise; quick:
 // sway and turns at 30 and 100 Hz, noise 0.01, 5 s.
 std::vector<GeneratedStreamSpec> generated_stream_specs(bool quick);
 

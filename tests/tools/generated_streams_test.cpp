@@ -91,6 +91,32 @@ TEST(GeneratedStreams, AStreamThatLosesPacketsLosesOneOrTwoSamplesAtATime) {
   expect_runs_lost(full, lossy, 1, 2, 70, 130);  // five a second on average over 20 s
 }
 
+TEST(GeneratedStreams, AStreamWithNoiseBurstsIsTheSameStreamWithItsNoiseFiveTimesAsLargeInThem) {
+  const QualitySequence plain = generated_stream({"sway", 60.0, 0.002, 20.0, 0.0, {}});
+  const QualitySequence bursts = generated_stream({"sway", 60.0, 0.002, 20.0, 0.0, {}, 0.0, 0.0, 5.0});
+  EXPECT_EQ(bursts.name, "sway-60Hz-noise0.002-bursts");
+  ASSERT_EQ(bursts.input.size(), plain.input.size());
+  int in_bursts = 0;
+  for (std::size_t i = 0; i < plain.input.size(); ++i) {
+    const double t = plain.input.time[i];
+    ASSERT_EQ(bursts.input.time[i], t);
+    const double phase = std::fmod(t, 5.0);
+    if (phase >= 3.0 && phase < 4.0) {
+      ++in_bursts;
+      Quat truth;
+      std::size_t cursor = 0;
+      ASSERT_TRUE(plain.truth.at(t, truth, cursor));
+      const double e_plain = so3::rotation_angle(truth, plain.input.orientation[i]);
+      const double e_bursts = so3::rotation_angle(truth, bursts.input.orientation[i]);
+      // (The truth is interpolated on a dense grid, within about 3e-7 rad of the exact one.)
+      EXPECT_NEAR(e_bursts, 5.0 * e_plain, 3e-6) << t;
+    } else {
+      EXPECT_EQ(bursts.input.orientation[i].coeffs(), plain.input.orientation[i].coeffs()) << t;
+    }
+  }
+  EXPECT_EQ(in_bursts, 4 * 60);  // 3–4, 8–9, 13–14, 18–19 s
+}
+
 TEST(GeneratedStreams, AnUnknownResamplingIsAnError) {
   EXPECT_THROW(generated_stream({"still", 250.0, 0.01, 5.0, 60.0, "cubic"}), std::invalid_argument);
 }
