@@ -192,7 +192,7 @@ QualitySequence generated_stream(const GeneratedStreamSpec& spec) {
   std::vector<Quat> measured;
   for (std::size_t i = 0; static_cast<double>(i) / measured_hz <= spec.seconds + 1.0 / measured_hz; ++i) {
     const double t = static_cast<double>(i) / measured_hz;
-    const double in_burst = std::fmod(t, kBurstEvery) >= kBurstFrom && std::fmod(t, kBurstEvery) < kBurstFrom + 1.0;
+    const bool in_burst = std::fmod(t, kBurstEvery) >= kBurstFrom && std::fmod(t, kBurstEvery) < kBurstFrom + 1.0;
     const Vec3 offset = random_offset(rng, spec.noise);
     measured.push_back((truth_at(t) * so3::exp(spec.burst_factor > 0.0 && in_burst ? spec.burst_factor * offset : offset)).normalized());
   }
