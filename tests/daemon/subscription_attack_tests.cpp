@@ -456,11 +456,14 @@ TEST(ControlSocket, CommandsAnswerAndOnlyTheGroupGetsIn) {
   EXPECT_GT(streams[0]["emitted"].get<std::uint64_t>(), 0u);
   EXPECT_TRUE(streams[0]["latency_us"]["p99"].is_number());
   // The latency by stage: every sample waited in a ring and was faired; the default has the
-  // engine publish (no hand-off), and what was sent was encoded.
+  // engine publish (no hand-off), and what was sent was encoded. The stages are read one after
+  // the other while both streams go on publishing, so a pose may be counted in one and not yet
+  // in the other (a run under TSan read 140 sent against 139 encoded).
   const auto stages = nlohmann::json::parse(d.ctl({"counters"}).second)["stages"];
   EXPECT_GT(stages["ring_wait"]["count"].get<std::uint64_t>(), 0u) << stages.dump();
   EXPECT_TRUE(stages["engine"]["p99"].is_number()) << stages.dump();
-  EXPECT_EQ(stages["send"]["count"], stages["encode"]["count"]) << stages.dump();
+  const auto sent = stages["send"]["count"].get<std::int64_t>(), encoded = stages["encode"]["count"].get<std::int64_t>();
+  EXPECT_LE(std::abs(sent - encoded), 4) << stages.dump();
   EXPECT_GT(stages["send"]["count"].get<std::uint64_t>(), 0u) << stages.dump();
   // The human table.
   Subprocess table({kPosefair, "ctl", "--socket", d.socket().string(), "streams"}, d.dir() / "t.out", d.dir() / "t.err");
