@@ -783,7 +783,7 @@ void FairingWindow::follow_rest(Channel& ch, bool departs) {
   const std::optional<RestLine::Value> value = ch.rest.line.value_at(0.0, ch.estimator.noise_variance(), kRestLineFactor);
   if (last < 0 || !value || !value->straight) {
     ch.rest.line.reset();
-    feed(0);
+    feed(std::max(0, n_ - ch.estimator.rest_span()));
   }
   ch.rest.resting = true;
 }

@@ -301,12 +301,31 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
       }
       if (settings_.motion_floor && settings_.rest_threshold > 0.0 && full) {
         const std::span<const Vec3> on = line_zeta.size() == zeta.size() ? line_zeta : zeta;
-        const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return line_[static_cast<std::size_t>(j)]; },
-                                           on.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
+        // After a motion stopped, the line through the samples clear of it, where they are enough
+        // (kRestLineMinSamples) and fewer than the window's: the rest is not put off until the
+        // motion has left the window. Its slope's square is scaled to the window line's noise, so
+        // that one average and one threshold serve both.
+        const int clear = span_ - 1 + e_.samples_since_stop;
+        const bool after_stop = e_.stopped_motion > 0.0 && clear < line_span_ && clear >= std::max(kRestLineMinSamples, span_);
+        double slope = 0.0;
+        if (after_stop) {
+          const double sxx = clear * (static_cast<double>(clear) * clear - 1.0) / 12.0;
+          const Vec3 v = weighted_vector_sum(0, clear - 1, [&](int j) { return (j + 1.0) * (clear - 1.0 - j) / (2.0 * sxx); },
+                                             on.subspan(static_cast<std::size_t>(n1 - (clear - 1))));
+          slope = v.squaredNorm() / 3.0 * line_noise_gain_ * sxx;
+        } else {
+          const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return line_[static_cast<std::size_t>(j)]; },
+                                             on.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
+          slope = v.squaredNorm() / 3.0;
+        }
         const double leaves = kRestLeaveFactor * settings_.rest_threshold * e_.noise_var * line_noise_gain_;
-        const double slope = std::min(v.squaredNorm() / 3.0, kRestSlopeCap * leaves);
-        e_.line_mean_square = e_.line_ready ? e_.line_mean_square + alpha * (slope - e_.line_mean_square) : slope;
+        slope = std::min(slope, kRestSlopeCap * leaves);
+        // The short line starts its average afresh: the one before held the motion.
+        const bool fresh = !e_.line_ready || (after_stop && !e_.line_after_stop);
+        e_.line_mean_square = fresh ? slope : e_.line_mean_square + alpha * (slope - e_.line_mean_square);
         e_.line_ready = true;
+        e_.line_after_stop = after_stop;
+        e_.line_clear = after_stop ? clear : 0;
       }
       e_.motion_ready = true;
       e_.motion_pending_s = 0.0;
@@ -338,7 +357,9 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
 
 MotionNoiseEstimator::StoppedMotion MotionNoiseEstimator::stopped_motion(int window) const {
   const int clear = span_ - 1 + e_.samples_since_stop;
-  if (e_.at_rest || e_.stopped_motion <= 0.0 || clear >= window - 1) return {};
+  // At rest only while the rest test's line is the short one after the stop: the motion is still
+  // in the window then, and the heaviest level would drag it into the still pose.
+  if ((e_.at_rest && !e_.line_after_stop) || e_.stopped_motion <= 0.0 || clear >= window - 1) return {};
   return {e_.stopped_motion, clear};
 }
 

@@ -19,7 +19,9 @@
 //     sees. A fit over half the span adds the motion's fast part (a shake) where it stands clear
 //     of its own noise.
 //   rest: a stream whose slope over the whole window is within its noise too is at rest (a
-//     tracker put down, a head held still). Then the floor is dropped, and the motion counts
+//     tracker put down, a head held still); after a motion has stopped, the slope over the
+//     samples since, so that a rest is not put off until the motion has left the window. Then
+//     the floor is dropped, and the motion counts
 //     only where the fit sees it stand out of its noise: a still stream is smoothed as hard
 //     as the window allows, a vibration (which a line through the window averages away but the
 //     fit sees) is not. A motion starting, from rest or faster than the motion before, is taken
@@ -119,6 +121,17 @@ class MotionNoiseEstimator {
   // the rest departure rule emitted more of its samples as measured: the jitter of quick turns
   // (`posefair bench streams`) rose by up to 22%, against 4% at 8.
   static constexpr double kRestSlopeCap = 8.0;
+  // After the stop rule (kMotionStopFactor) the rest test's line spans only the samples clear of
+  // the motion (the fit's span and the samples since), at least this many, until the window's
+  // line is clear too: the rest was seen no sooner than the motion had left the window (0.5 s),
+  // 0.8–0.9 s after a turn, and is now seen about 0.25 s after it. The rest line begins from
+  // those samples, and the level chosen at rest still weighs the drag of rows that reach back
+  // into the motion (stopped_motion): without that the heaviest level dragged each turn into the
+  // rest after it (quick turns of `posefair bench streams` from 11% more error to 300 times it).
+  // Never fewer than the fit's span either (at 10 Hz then none: the window holds 8; a rest test
+  // on the fit's 3 samples there read TUM's handheld camera as still, docs/engine.md "At rest").
+  // 16 and 32 gained less.
+  static constexpr int kRestLineMinSamples = 8;
   // At rest, the motion's average counts (over rest_threshold times the fit's noise) only while
   // a fit stands clear of its noise too: the newest this many times over it (a motion starting),
   // or one of the last half to whole span kRestOnsetFactor times (a vibration, whose fit passes
@@ -222,6 +235,10 @@ class MotionNoiseEstimator {
     bool window_ready = false;
     double line_mean_square = 0.0;
     bool line_ready = false;
+    // The rest test's line is the one through the samples clear of a motion that stopped (their
+    // number; 0: the window's line).
+    bool line_after_stop = false;
+    int line_clear = 0;
     double bias_motion = 0.0;  // d² implied by corrections over kBiasFactor times their noise, decaying
     double bias_last = 0.0;    // the last correction's implied d² (0: within that)
     bool at_rest = false;
@@ -255,6 +272,9 @@ class MotionNoiseEstimator {
   };
   StoppedMotion stopped_motion(int window) const;
   bool at_rest() const { return e_.at_rest; }
+  // How many of the newest samples the rest test's line spans: the window's, or after a motion
+  // stopped those clear of it. A rest line begun now takes these.
+  int rest_span() const { return e_.line_after_stop ? e_.line_clear : line_span_; }
   double noise_variance() const { return e_.noise_var; }    // σ², per component, per sample
   double motion_variance() const { return e_.motion_var; }  // d², per component, per sample^(2m)
   int span() const { return span_; }
