@@ -774,16 +774,19 @@ void FairingWindow::follow_rest(Channel& ch, bool departs) {
   }
   // The rest begins again. Where the rest test let go of it only for a moment (the window's
   // slope is noisy too, so it does now and then), the line takes the samples it missed from the
-  // window and goes on, if it is still straight; otherwise it starts from the window's samples.
+  // window and goes on, if it is still straight; otherwise it starts afresh. Either only from the
+  // samples the rest test's line spans: the window's, or after a motion stopped those clear of it
+  // (an earlier rest's last sample may still be in the window, before the motion).
+  const int first = std::max(0, n_ - ch.estimator.rest_span());
   int last = -1;
   if (!ch.rest.line.empty())
-    for (int i = n_ - 1; i >= 0 && last < 0; --i)
+    for (int i = n_ - 1; i >= first && last < 0; --i)
       if (samples_[static_cast<std::size_t>(i)].time == ch.rest.time) last = i;
   if (last >= 0) feed(last + 1);
   const std::optional<RestLine::Value> value = ch.rest.line.value_at(0.0, ch.estimator.noise_variance(), kRestLineFactor);
   if (last < 0 || !value || !value->straight) {
     ch.rest.line.reset();
-    feed(std::max(0, n_ - ch.estimator.rest_span()));
+    feed(first);
   }
   ch.rest.resting = true;
 }
