@@ -305,7 +305,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
         // (kRestLineMinSamples) and fewer than the window's: the rest is not put off until the
         // motion has left the window. Its slope's square is scaled to the window line's noise, so
         // that one average and one threshold serve both.
-        const int clear = span_ - 1 + e_.samples_since_stop;
+        const int clear = samples_clear_of_stop();
         const bool after_stop = e_.stopped_motion > 0.0 && clear < line_span_ && clear >= std::max(kRestLineMinSamples, span_);
         double slope = 0.0;
         if (after_stop) {
@@ -321,10 +321,9 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
         const double leaves = kRestLeaveFactor * settings_.rest_threshold * e_.noise_var * line_noise_gain_;
         slope = std::min(slope, kRestSlopeCap * leaves);
         // The short line starts its average afresh: the one before held the motion.
-        const bool fresh = !e_.line_ready || (after_stop && !e_.line_after_stop);
+        const bool fresh = !e_.line_ready || (after_stop && e_.line_clear == 0);
         e_.line_mean_square = fresh ? slope : e_.line_mean_square + alpha * (slope - e_.line_mean_square);
         e_.line_ready = true;
-        e_.line_after_stop = after_stop;
         e_.line_clear = after_stop ? clear : 0;
       }
       e_.motion_ready = true;
@@ -356,10 +355,10 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
 }
 
 MotionNoiseEstimator::StoppedMotion MotionNoiseEstimator::stopped_motion(int window) const {
-  const int clear = span_ - 1 + e_.samples_since_stop;
+  const int clear = samples_clear_of_stop();
   // At rest only while the rest test's line is the short one after the stop: the motion is still
   // in the window then, and the heaviest level would drag it into the still pose.
-  if ((e_.at_rest && !e_.line_after_stop) || e_.stopped_motion <= 0.0 || clear >= window - 1) return {};
+  if ((e_.at_rest && e_.line_clear == 0) || e_.stopped_motion <= 0.0 || clear >= window - 1) return {};
   return {e_.stopped_motion, clear};
 }
 

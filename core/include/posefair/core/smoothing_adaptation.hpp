@@ -235,9 +235,8 @@ class MotionNoiseEstimator {
     bool window_ready = false;
     double line_mean_square = 0.0;
     bool line_ready = false;
-    // The rest test's line is the one through the samples clear of a motion that stopped (their
-    // number; 0: the window's line).
-    bool line_after_stop = false;
+    // The rest test's line is the one through this many samples clear of a motion that stopped
+    // (0: the window's line).
     int line_clear = 0;
     double bias_motion = 0.0;  // d² implied by corrections over kBiasFactor times their noise, decaying
     double bias_last = 0.0;    // the last correction's implied d² (0: within that)
@@ -274,12 +273,15 @@ class MotionNoiseEstimator {
   bool at_rest() const { return e_.at_rest; }
   // How many of the newest samples the rest test's line spans: the window's, or after a motion
   // stopped those clear of it. A rest line begun now takes these.
-  int rest_span() const { return e_.line_after_stop ? e_.line_clear : line_span_; }
+  int rest_span() const { return e_.line_clear > 0 ? e_.line_clear : line_span_; }
   double noise_variance() const { return e_.noise_var; }    // σ², per component, per sample
   double motion_variance() const { return e_.motion_var; }  // d², per component, per sample^(2m)
   int span() const { return span_; }
 
  private:
+  // The newest samples clear of the motion the stop rule saw stop: the fit's span, within its
+  // noise when the rule fired, and the samples since.
+  int samples_clear_of_stop() const { return span_ - 1 + e_.samples_since_stop; }
   // Takes a length ‖D^kθ‖ into the tracker of its order's median.
   void update_median(Estimates::LengthMedian& m, double length, double dt) const;
   // The least motion assumed while moving: the noise the fit lets through, or less where the
