@@ -333,10 +333,17 @@ void FairingWindow::prepare(double rate_hz) {
       for (int l = 0; l + 1 < level_count_; ++l)
         level_shared_gain_[static_cast<std::size_t>(l)] =
             shared_noise_gain(levels_[static_cast<std::size_t>(l)], levels_[static_cast<std::size_t>(l + 1)], w_, k);
-      for (int c = 0; c + 1 < w_; ++c)
-        for (int l = 0; l < level_count_; ++l)
-          level_tail_bias_[static_cast<std::size_t>(c * kMaxSmoothingLevels + l)] =
-              tail_bias(levels_[static_cast<std::size_t>(l)], w_, target_spec_, c);
+      // Each level's drag for a motion that stopped c samples back, at its largest for any c' ≥ c:
+      // a stop is known only to lie at least c samples back (the fit's span, or its newest half,
+      // within the noise), and the drag of the polynomial end tail_bias assumes crosses zero at
+      // some c for the heavier levels (level 15 at 250 Hz: 0.0075 at c = 30, 0.73 at 31), where a
+      // real turn's end drags all the same (a clean turn at 250 Hz: one pose 0.007 rad off).
+      for (int c = w_ - 2; c >= 0; --c)
+        for (int l = 0; l < level_count_; ++l) {
+          const double here = std::abs(tail_bias(levels_[static_cast<std::size_t>(l)], w_, target_spec_, c));
+          const double later = c + 2 < w_ ? level_tail_bias_[static_cast<std::size_t>((c + 1) * kMaxSmoothingLevels + l)] : 0.0;
+          level_tail_bias_[static_cast<std::size_t>(c * kMaxSmoothingLevels + l)] = std::max(here, later);
+        }
       rot_.estimator.configure(rate_hz, config_.adaptation, w_);
       pos_.estimator.configure(rate_hz, config_.adaptation, w_);
       AdaptationSettings aided = config_.adaptation;

@@ -59,6 +59,21 @@ double derivative_fit_weights(int span, int m, std::vector<double>& out) {
       out);
 }
 
+// The least-squares slope of a line through the newest `samples` samples (per sample), from
+// their differences ζ (the last samples − 1 of zeta), and Σ(i − c)² over them: the slope's noise
+// gain on θ is its inverse. The weights in closed form, (j + 1)(L − 1 − j)/(2·Sxx) on the j-th
+// difference, summed as difference_weights would: the span changes from one call to the next.
+struct LineSlope {
+  Vec3 slope;
+  double sxx;
+};
+LineSlope newest_line_slope(std::span<const Vec3> zeta, int samples) {
+  const double l = samples, sxx = l * (l * l - 1.0) / 12.0;
+  const Vec3 v = weighted_vector_sum(0, samples - 1, [&](int j) { return (j + 1.0) * (l - 1.0 - j) / (2.0 * sxx); },
+                                     zeta.subspan(zeta.size() - static_cast<std::size_t>(samples - 1)));
+  return {v, sxx};
+}
+
 // The componentwise median of three vectors.
 Vec3 median_of_three(const Vec3& a, const Vec3& b, const Vec3& c) {
   return a.cwiseMin(b).cwiseMax(a.cwiseMax(b).cwiseMin(c));
@@ -226,18 +241,28 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
     if (!e_.motion_ready || e_.motion_pending_s >= (1.0 - 1e-9) * settings_.motion_time_s / kMotionRefreshes) {
       const Vec3 d = weighted_vector_sum(0, span_ - 1, [&](int j) { return fit_[static_cast<std::size_t>(j)]; },
                                          zeta.subspan(static_cast<std::size_t>(n1 - (span_ - 1))));
-      const double sample = d.squaredNorm() / 3.0;
+      double sample = d.squaredNorm() / 3.0;
       const double alpha = e_.motion_ready ? 1.0 - std::exp(-e_.motion_pending_s / settings_.motion_time_s) : 1.0;
+      // The fast part's fit on the newest half span and on the half before it, the smaller of
+      // the two: an outlier sits in one of them, a shake in both.
+      auto half_fit = [&](int back) {
+        const Vec3 v = weighted_vector_sum(0, short_span_ - 1, [&](int j) { return short_fit_[static_cast<std::size_t>(j)]; },
+                                           zeta.subspan(static_cast<std::size_t>(n1 - back - (short_span_ - 1))));
+        return v.squaredNorm() / 3.0;
+      };
+      const double h0 = short_span_ > 0 ? half_fit(0) : 0.0;
+      double h1 = short_span_ > 0 ? half_fit(short_span_) : 0.0;
+      // After a stop seen on the newest half span (below), the long fit still holds the motion
+      // until its span is clear of it: the newest half's fit stands for it, scaled from its noise
+      // to the long fit's (so that noise alone reads the same in both, and the onset rule takes a
+      // motion starting again as it would), and for the half before it.
+      const bool half_stands_in = e_.stopped_motion > 0.0 && samples_clear_of_stop() < span_;
+      if (half_stands_in) {
+        sample = fit_noise * h0 / short_noise;
+        h1 = h0;
+      }
       e_.mean_square += alpha * (sample - e_.mean_square);
       if (short_span_ > 0) {
-        // The fast part's fit on the newest half span and on the half before it, the smaller of
-        // the two: an outlier sits in one of them, a shake in both.
-        auto half_fit = [&](int back) {
-          const Vec3 v = weighted_vector_sum(0, short_span_ - 1, [&](int j) { return short_fit_[static_cast<std::size_t>(j)]; },
-                                             zeta.subspan(static_cast<std::size_t>(n1 - back - (short_span_ - 1))));
-          return v.squaredNorm() / 3.0;
-        };
-        const double h0 = half_fit(0), h1 = half_fit(short_span_);
         const double fast = std::min(h0, h1);
         e_.short_mean_square += alpha * (fast - e_.short_mean_square);
         // A motion stopping: the averages would come down from a turn at a factor e per
@@ -248,15 +273,29 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
         // averages drop to the noise.
         // Not where the motion is near the noise (its fits are within it half the time): the
         // quality benchmark's 1 kHz set under noise 0.05 lost 0.4% without that condition.
-        const bool stopped = e_.mean_square > kRestOnsetFactor * fit_noise && sample < kMotionStopFactor * fit_noise &&
-                             std::max(h0, h1) < kMotionStopFactor * short_noise;
-        if (stopped && e_.stop_last) {
-          e_.stopped_motion = std::max(0.0, e_.mean_square - fit_noise);
-          e_.samples_since_stop = 0;
+        // A tracker coming to rest is seen sooner on the newest half span alone: its fit within
+        // kMotionStopFactor times its noise and the slope of a line through it within its noise
+        // (the pose no longer moves, where the fit alone would pass a steady turn), twice running.
+        // Only the newest half span is clear of the motion then (kStillSlopeFactor).
+        const bool clear_motion = e_.mean_square > kRestOnsetFactor * fit_noise;
+        const bool stopped = clear_motion && sample < kMotionStopFactor * fit_noise && std::max(h0, h1) < kMotionStopFactor * short_noise;
+        bool half_stopped = false;
+        if (!stopped && !half_stands_in && clear_motion && h0 < kMotionStopFactor * short_noise) {
+          const LineSlope line = newest_line_slope(zeta, short_span_);
+          half_stopped = line.slope.squaredNorm() / 3.0 < kStillSlopeFactor * e_.noise_var / line.sxx;
+        }
+        if ((stopped || half_stopped) && e_.stop_last) {
+          // A motion stopped again while one is still in the window: the larger of the two drags,
+          // and (while the newest half stands in) the samples clear of it stay as they were.
+          e_.stopped_motion = std::max(e_.stopped_motion, e_.mean_square - fit_noise);
+          if (!half_stands_in) {
+            e_.stop_clear = half_stopped ? short_span_ : span_;
+            e_.samples_since_stop = 0;
+          }
           e_.mean_square = fit_noise;
           e_.short_mean_square = std::min(e_.short_mean_square, short_noise);
         }
-        e_.stop_last = stopped;
+        e_.stop_last = stopped || half_stopped;
       }
       // A motion starting: the average would take motion_time_s to see it, smoothing the start
       // of the motion as hard as what came before. A fit that stands over the onset threshold
@@ -309,10 +348,8 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
         const bool after_stop = e_.stopped_motion > 0.0 && clear < line_span_ && clear >= std::max(kRestLineMinSamples, span_);
         double slope = 0.0;
         if (after_stop) {
-          const double sxx = clear * (static_cast<double>(clear) * clear - 1.0) / 12.0;
-          const Vec3 v = weighted_vector_sum(0, clear - 1, [&](int j) { return (j + 1.0) * (clear - 1.0 - j) / (2.0 * sxx); },
-                                             on.subspan(static_cast<std::size_t>(n1 - (clear - 1))));
-          slope = v.squaredNorm() / 3.0 * line_noise_gain_ * sxx;
+          const LineSlope line = newest_line_slope(on, clear);
+          slope = line.slope.squaredNorm() / 3.0 * line_noise_gain_ * line.sxx;
         } else {
           const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return line_[static_cast<std::size_t>(j)]; },
                                              on.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
@@ -356,9 +393,8 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
 
 MotionNoiseEstimator::StoppedMotion MotionNoiseEstimator::stopped_motion(int window) const {
   const int clear = samples_clear_of_stop();
-  // At rest only while the rest test's line is the short one after the stop: the motion is still
-  // in the window then, and the heaviest level would drag it into the still pose.
-  if ((e_.at_rest && e_.line_clear == 0) || e_.stopped_motion <= 0.0 || clear >= window - 1) return {};
+  // At rest too: the heaviest level would drag the motion into the still pose.
+  if (e_.stopped_motion <= 0.0 || clear >= window - 1) return {};
   return {e_.stopped_motion, clear};
 }
 

@@ -352,8 +352,8 @@ class FairingWindow {
   std::vector<EmissionRow> levels_;  // candidate rows for the adaptation, least smoothing first
   std::array<double, kMaxSmoothingLevels> level_shared_gain_{};  // [l]: shared_noise_gain of levels l, l + 1
   int level_count_ = 0;
-  // [c·kMaxSmoothingLevels + l]: level l's tail_bias for a motion that stopped c samples before
-  // the newest (c < W − 1).
+  // [c·kMaxSmoothingLevels + l]: level l's |tail_bias| for a motion that stopped c or more
+  // samples before the newest, the largest (c < W − 1).
   std::vector<double> level_tail_bias_;
   EmissionRow fill_row_;             // scratch: the row of a window still filling
   EmissionRow fill_newest_row_;      // scratch: its estimate of the newest sample (fill_moves)

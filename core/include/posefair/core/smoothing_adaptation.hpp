@@ -155,6 +155,16 @@ class MotionNoiseEstimator {
   // noise twice running, about 1 in 25 after a turn had stopped) and took half the gain on the
   // rests set (1.3% instead of 2.3%); at 3 a shake and a walk at 250 Hz and 1 kHz lost 1–2%.
   static constexpr double kMotionStopFactor = 2.0;
+  // The long fit spans 0.25 s: a turn's stop was seen no sooner than that after its end, and the
+  // first 0.25 s after each turn held a fifth of the quality benchmark's error on its rests set
+  // and as much of its jitter, smoothed as lightly as the turn. The newest half span's fit within
+  // kMotionStopFactor times its noise and its line's slope within this many times the slope's
+  // noise (the pose no longer moves), twice running after a clear motion, are a stop too (about
+  // 0.1 s after a turn at 100 Hz), with only that half span clear of the motion; until the long
+  // span is clear, the half's fit stands for the long one. At 2 a 5 Hz vibration under noise was
+  // taken for stops (1.5% more error, `Adaptation.AVibrationIsNotTakenForRest`). docs/engine.md,
+  // "A stop seen on the newest half span".
+  static constexpr double kStillSlopeFactor = 1.0;
   // A smoothing level's correction (output − measurement) that stands this many times over what
   // the noise alone puts in it (its mean square against σ² times the level's correction gain) is
   // bias: motion the estimate missed. The m-th difference that bias implies through the level's
@@ -248,6 +258,7 @@ class MotionNoiseEstimator {
     // the window's older samples until the window has slid past it.
     double stopped_motion = 0.0;
     int samples_since_stop = 0;
+    int stop_clear = 0;  // the newest samples clear of it when it stopped: the fit's span or half span
     // The largest fit of the last half span and of the half span before it (in stream time), and
     // the time the newer half has run: the largest fit of the last half to whole span.
     double peak = 0.0, peak_before = 0.0, peak_s = 0.0;
@@ -261,10 +272,11 @@ class MotionNoiseEstimator {
 
   bool ready() const { return e_.low.count > 0 && e_.motion_ready; }
   // A motion that stopped while still in the window: its d² (per component, per sample^(2m)) and
-  // how many of the newest samples are clear of it (the fit's span, within its noise when the
-  // stop rule fired, and the samples since). None (motion_var 0) at rest, or once `window`
-  // samples are clear. The level chosen weighs the drag each row puts on the still pose
-  // (tail_bias in smoother_rows.hpp).
+  // how many of the newest samples are clear of it (samples_clear_of_stop). At rest too (only
+  // while the rest test's line was the short one until a stop could be seen on the half span:
+  // then a rest begun on the window's line had the motion clear of the window's rows); none once
+  // `window` samples are clear. Of two stops while one is in the window, the larger d². The level
+  // chosen weighs the drag each row puts on the still pose (tail_bias in smoother_rows.hpp).
   struct StoppedMotion {
     double motion_var = 0.0;
     int clear = 0;
@@ -279,9 +291,9 @@ class MotionNoiseEstimator {
   int span() const { return span_; }
 
  private:
-  // The newest samples clear of the motion the stop rule saw stop: the fit's span, within its
-  // noise when the rule fired, and the samples since.
-  int samples_clear_of_stop() const { return span_ - 1 + e_.samples_since_stop; }
+  // The newest samples clear of the motion the stop rule saw stop: the fit's span (or its newest
+  // half, kStillSlopeFactor), within its noise when the rule fired, and the samples since.
+  int samples_clear_of_stop() const { return e_.stop_clear - 1 + e_.samples_since_stop; }
   // Takes a length ‖D^kθ‖ into the tracker of its order's median.
   void update_median(Estimates::LengthMedian& m, double length, double dt) const;
   // The least motion assumed while moving: the noise the fit lets through, or less where the
