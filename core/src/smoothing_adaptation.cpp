@@ -256,9 +256,9 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
       // until its span is clear of it: the newest half's fit stands for it, scaled from its noise
       // to the long fit's (so that noise alone reads the same in both, and the onset rule takes a
       // motion starting again as it would), and for the half before it.
-      const bool half_stands_in = e_.stopped_motion > 0.0 && samples_clear_of_stop() < span_;
+      const bool half_stands_in = short_span_ > 0 && e_.stopped_motion > 0.0 && samples_clear_of_stop() < span_;
       if (half_stands_in) {
-        sample = fit_noise * h0 / short_noise;
+        sample = h0 * (fit_noise_gain_ / short_fit_noise_gain_);
         h1 = h0;
       }
       e_.mean_square += alpha * (sample - e_.mean_square);
