@@ -62,7 +62,8 @@ double derivative_fit_weights(int span, int m, std::vector<double>& out) {
 // The least-squares slope of a line through the newest `samples` samples (per sample), from
 // their differences ζ (the last samples − 1 of zeta), and Σ(i − c)² over them: the slope's noise
 // gain on θ is its inverse. The weights in closed form, (j + 1)(L − 1 − j)/(2·Sxx) on the j-th
-// difference, summed as difference_weights would: the span changes from one call to the next.
+// difference, summed as difference_weights would: after a stop the span changes from one call to
+// the next, and one closed form serves it and the window's line.
 struct LineSlope {
   Vec3 slope;
   double sxx;
@@ -107,8 +108,7 @@ MotionNoiseEstimator::MotionNoiseEstimator(int capacity, int order)
       low_(noise_difference(order + 2)),
       fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
       short_fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
-      window_fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
-      line_(static_cast<std::size_t>(std::max(1, capacity)), 0.0) {}
+      window_fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0) {}
 
 void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& settings, int window) {
   settings_ = settings;
@@ -127,12 +127,10 @@ void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& s
   // 10 Hz with the default span).
   short_span_ = span_ / 2 >= m + 1 ? span_ / 2 : 0;
   if (short_span_ > 0) short_fit_noise_gain_ = derivative_fit_weights(short_span_, m, short_fit_);
-  // The least-squares slope of a line through the window: w_i = (i − c)/Σ(i − c)².
+  // The least-squares slope of a line through the window (newest_line_slope): its noise gain
+  // on θ is 1/Σ(i − c)².
   line_span_ = std::clamp(window, 2, std::max(2, capacity_));
-  const double cl = 0.5 * (line_span_ - 1);
-  double sxx = 0.0;
-  for (int i = 0; i < line_span_; ++i) sxx += (i - cl) * (i - cl);
-  line_noise_gain_ = difference_weights(line_span_, [&](int i) { return (i - cl) / sxx; }, line_);
+  line_noise_gain_ = 12.0 / (line_span_ * (static_cast<double>(line_span_) * line_span_ - 1.0));
   // The slow part's fit over the window: its m-th derivative has (W/span)^(2m+1) times less noise
   // (32 times at m = 2), so it tells a slow motion from none where the fit above cannot. Not where
   // the window's minimum of samples stretches it past twice the fit's span (under 14 Hz with the
@@ -346,15 +344,8 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
         // that one average and one threshold serve both.
         const int clear = samples_clear_of_stop();
         const bool after_stop = e_.stopped_motion > 0.0 && clear < line_span_ && clear >= std::max(kRestLineMinSamples, span_);
-        double slope = 0.0;
-        if (after_stop) {
-          const LineSlope line = newest_line_slope(on, clear);
-          slope = line.slope.squaredNorm() / 3.0 * line_noise_gain_ * line.sxx;
-        } else {
-          const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return line_[static_cast<std::size_t>(j)]; },
-                                             on.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
-          slope = v.squaredNorm() / 3.0;
-        }
+        const LineSlope line = newest_line_slope(on, after_stop ? clear : line_span_);
+        double slope = line.slope.squaredNorm() / 3.0 * line_noise_gain_ * line.sxx;  // (× 1 on the window's line)
         const double leaves = kRestLeaveFactor * settings_.rest_threshold * e_.noise_var * line_noise_gain_;
         slope = std::min(slope, kRestSlopeCap * leaves);
         // The short line starts its average afresh: the one before held the motion.

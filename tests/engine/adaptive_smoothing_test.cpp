@@ -718,9 +718,9 @@ TEST(Adaptation, ATurnOutOfRestIsFollowedFromItsSecondSample) {
 }
 
 // A quick turn (1.5 rad about y in 0.5 s from t = 2 s, smoothstep in the angle), then still,
-// under noise of 0.005 rad per axis.
-Stream turn_then_still(double rate, double seconds, std::uint64_t seed) {
-  return with_noise(rate, seconds, 0.005, seed, [](double t) {
+// under noise of sigma rad per axis.
+Stream turn_then_still(double rate, double seconds, std::uint64_t seed, double sigma = 0.005) {
+  return with_noise(rate, seconds, sigma, seed, [](double t) {
     const double u = std::clamp((t - 2.0) / 0.5, 0.0, 1.0);
     return so3::from_rotation_vector(Vec3(0.0, 1.5 * u * u * (3.0 - 2.0 * u), 0.0));
   });
@@ -766,7 +766,7 @@ TEST(Adaptation, ARestAfterATurnIsSeenSoon) {
 }
 
 TEST(Adaptation, AStillnessIsSeenOnTheNewestHalfSpan) {
-  // A turn (1.5 rad in 0.5 s, smoothstep in the angle), then still. The stop rule saw the turn
+  // A turn, then still (turn_then_still). The stop rule saw the turn
   // stop once the long fit's span (0.25 s) was clear of it, and until then the stream was smoothed
   // as lightly as in the turn. Now the newest half span's fit and line within the noise are a stop
   // too (kStillSlopeFactor), and the half's fit stands for the long one until its span is clear.
@@ -783,10 +783,7 @@ TEST(Adaptation, AStillnessIsSeenOnTheNewestHalfSpan) {
     SCOPED_TRACE(std::to_string(c.rate) + " Hz, noise " + std::to_string(c.sigma));
     double first = 0.0, first_raw = 0.0, second = 0.0, second_raw = 0.0;
     for (std::uint64_t seed = 1; seed <= 5; ++seed) {
-      const Stream s = with_noise(c.rate, 4.0, c.sigma, seed, [](double t) {
-        const double u = std::clamp((t - 2.0) / 0.5, 0.0, 1.0);
-        return so3::from_rotation_vector(Vec3(0.0, 1.5 * u * u * (3.0 - 2.0 * u), 0.0));
-      });
+      const Stream s = turn_then_still(c.rate, 4.0, seed, c.sigma);
       const std::vector<Quat> out = fair_causal(s.input, WindowConfig{}).poses.orientation;
       first += std::pow(rms_error_between(s, out, 2.5, 2.75), 2);
       first_raw += std::pow(rms_error_between(s, s.input.orientation, 2.5, 2.75), 2);

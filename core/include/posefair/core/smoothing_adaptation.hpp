@@ -320,10 +320,8 @@ class MotionNoiseEstimator {
   // that spans more than twice motion_span_s), and its noise gain.
   std::vector<double> window_fit_;
   double window_fit_noise_gain_ = 0.0;
-  // Rest: the slope of a line through the newest line_span_ samples (weights on their
-  // differences, as fit_), and Σ of its squared weights on θ.
+  // Rest: a line through the newest line_span_ samples, and Σ of its slope's squared weights on θ.
   int line_span_ = 0;
-  std::vector<double> line_;
   double line_noise_gain_ = 0.0;
   Estimates e_;
 };
