@@ -762,7 +762,9 @@ void FairingWindow::follow_rest(Channel& ch, bool departs) {
         if (&ch == &pos_) ch.rest.origin = zp_[j];
       }
       // From the last sample the line took (a sample off it is skipped).
-      ch.rest.line.add(first ? 0.0 : samples_[j].time - ch.rest.time, rest_coordinate(ch, i), memory);
+      // Weighed by the inverse of its noise: a sample taken in a burst of noise counts for less.
+      ch.rest.line.add(first ? 0.0 : samples_[j].time - ch.rest.time, rest_coordinate(ch, i), memory,
+                       ch.estimator.noise_variance() / ch.estimator.rest_noise_variance());
       ch.rest.time = samples_[j].time;
     }
   };
@@ -790,7 +792,7 @@ void FairingWindow::follow_rest(Channel& ch, bool departs) {
     for (int i = n_ - 1; i >= first && last < 0; --i)
       if (samples_[static_cast<std::size_t>(i)].time == ch.rest.time) last = i;
   if (last >= 0) feed(last + 1);
-  const std::optional<RestLine::Value> value = ch.rest.line.value_at(0.0, ch.estimator.noise_variance(), kRestLineFactor);
+  const std::optional<RestLine::Value> value = ch.rest.line.value_at(0.0, ch.estimator.rest_noise_variance(), kRestLineFactor);
   if (last < 0 || !value || !value->straight) {
     ch.rest.line.reset();
     feed(first);
@@ -808,7 +810,7 @@ Vec3 FairingWindow::rest_blend(Channel& ch, int k, const Vec3& window, double dt
   const double age = ch.rest.time - samples_[static_cast<std::size_t>(k)].time - config_.horizon_s;
   const std::optional<RestLine::Value> value =
       ch.rest.resting && ch.estimator.motion_variance() == 0.0
-          ? ch.rest.line.value_at(age, ch.estimator.noise_variance(), kRestLineFactor)
+          ? ch.rest.line.value_at(age, ch.estimator.rest_noise_variance(), kRestLineFactor)
           : std::nullopt;
   if (!value) {
     ch.rest.weight = 0.0;

@@ -51,7 +51,7 @@ void RestLine::reset() {
   values_ = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
 }
 
-void RestLine::add(double dt, const Vec3& y, double memory_s) {
+void RestLine::add(double dt, const Vec3& y, double memory_s, double weight) {
   if (!empty() && dt > 0.0) {
     age_by(weights_, dt);
     age_by(squares_, dt);
@@ -62,9 +62,10 @@ void RestLine::add(double dt, const Vec3& y, double memory_s) {
     for (Vec3& v : values_) v *= decay;
     steps_ = std::min(steps_ + 1, 2);
   }
-  weights_[0] += 1.0;
-  squares_[0] += 1.0;
-  values_[0] += y;
+  // Its noise is 1/weight times the others': w²·(σ²/weight) = weight·σ² in the noise sums.
+  weights_[0] += weight;
+  squares_[0] += weight;
+  values_[0] += weight * y;
 }
 
 std::optional<std::array<double, 2>> RestLine::line_weights(double age) const {

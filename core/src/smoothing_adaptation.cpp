@@ -5,6 +5,7 @@
 #include "posefair/core/weighted_vector_sum.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include <Eigen/Cholesky>
@@ -90,6 +91,7 @@ NoiseDifference noise_difference(int k) {
   d.order = k;
   for (int j = 0; j < k; ++j) d.weights[static_cast<std::size_t>(j)] = ((k - 1 - j) % 2 == 0 ? 1.0 : -1.0) * binomial(k - 1, j);
   d.sigma_per_median = 1.0 / (kChi3Median * std::sqrt(binomial(2 * k, k)));
+  d.var_per_square = 1.0 / (3.0 * binomial(2 * k, k));
   return d;
 }
 
@@ -163,11 +165,27 @@ void MotionNoiseEstimator::update_median(Estimates::LengthMedian& m, double leng
     m.run = above ? std::max(m.run, 0) + 1 : std::min(m.run, 0) - 1;
     const double far = std::log(kNoiseFarFactor);
     m.far_run = from_median > far ? std::max(m.far_run, 0) + 1 : from_median < -far ? std::min(m.far_run, 0) - 1 : 0;
+    m.recent_far = (m.recent_far << 1) | (from_median > far ? 1u : 0u);
+    m.recent_square += kRecentNoiseWeight * (length * length - m.recent_square);
     double step = std::min(0.5, 0.5 * dt / settings_.noise_time_s);
     const int beyond = std::max(std::abs(m.run) - kNoiseRunSamples, std::abs(m.far_run) - kNoiseFarSamples);
     if (beyond > 0) step = std::max(step, std::min(kNoiseRunStepCap, std::ldexp(step, std::min(beyond, 60))));
     m.log_median += above ? step : -step;
   }
+}
+
+double MotionNoiseEstimator::recent_noise_var() const {
+  // Not where the newest lengths reach past the motion fit's span (under 32 Hz with the
+  // defaults): there a quick turn lasts a few samples and fills most of them.
+  if (kRecentNoiseSamples > span_ + 1) return 0.0;
+  auto recent = [](const Estimates::LengthMedian& m, const NoiseDifference& d) {
+    const int far = std::popcount(m.recent_far & ((1u << kRecentNoiseSamples) - 1u));
+    return m.settled() && 2 * far > kRecentNoiseSamples ? m.recent_square * d.var_per_square : 0.0;
+  };
+  double v = recent(e_.low, low_);
+  // Both orders, as the tracked σ: a motion at a third of the rate fills the lower one.
+  if (v > 0.0 && high_.order > 0) v = std::min(v, kNoiseOrderMargin * kNoiseOrderMargin * recent(e_.high, high_));
+  return v;
 }
 
 double MotionNoiseEstimator::newest_half_fit_of_medians(std::span<const Vec3> zeta) const {
@@ -226,8 +244,11 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
     }
     if (e_.low.count > 0) e_.noise_var = s * s;  // (none yet where only stand-ins' differences came)
   }
+  // A rest is judged against the noise the newest samples show where it has risen (kRecentNoiseSamples).
+  e_.rest_noise_var = std::max(e_.noise_var, recent_noise_var());
   // The noise each fit lets through, at the noise estimate just updated.
   const double fit_noise = e_.noise_var * fit_noise_gain_;
+  const double rest_fit_noise = e_.rest_noise_var * fit_noise_gain_;
   const double short_noise = e_.noise_var * short_fit_noise_gain_;
   // The fit is taken at most kMotionRefreshes times per motion_time_s (every 4 ms by default):
   // the estimate averages over motion_time_s anyway, and fits a few samples apart share nearly
@@ -302,7 +323,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
       // kMotionOnsetFactor times the motion's (or the noise's, if larger). A single outlier's fit
       // is largest as it enters the span and shrinks after; where it grows again (towards the
       // span's centre) it stands at most a quarter as high.
-      const double onset = e_.at_rest ? kRestOnsetFactor * fit_noise
+      const double onset = e_.at_rest ? kRestOnsetFactor * rest_fit_noise
                                     : fit_noise + kMotionOnsetFactor * std::max(e_.mean_square - fit_noise, fit_noise);
       const bool over = sample > onset;
       if (over && e_.onset_over && sample > e_.onset_last) {
@@ -346,7 +367,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
         const bool after_stop = e_.stopped_motion > 0.0 && clear < line_span_ && clear >= std::max(kRestLineMinSamples, span_);
         const LineSlope line = newest_line_slope(on, after_stop ? clear : line_span_);
         double slope = line.slope.squaredNorm() / 3.0 * line_noise_gain_ * line.sxx;  // (× 1 on the window's line)
-        const double leaves = kRestLeaveFactor * settings_.rest_threshold * e_.noise_var * line_noise_gain_;
+        const double leaves = kRestLeaveFactor * settings_.rest_threshold * e_.rest_noise_var * line_noise_gain_;
         slope = std::min(slope, kRestSlopeCap * leaves);
         // The short line starts its average afresh: the one before held the motion.
         const bool fresh = !e_.line_ready || (after_stop && e_.line_clear == 0);
@@ -361,7 +382,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
   }
   if (e_.motion_ready) {
     const double threshold = settings_.rest_threshold;
-    const double line_noise = e_.noise_var * line_noise_gain_;
+    const double line_noise = e_.rest_noise_var * line_noise_gain_;
     // While the line is not ready again (a window filling after a gap, which the line does not
     // span) a rest stays a rest: FairingWindow ends it where a sample leaves the rest line.
     e_.at_rest = settings_.motion_floor && threshold > 0.0 &&
@@ -369,14 +390,15 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
     if (e_.at_rest) {
       // The average counts only while a fit stands clear of the noise too: the newest (a motion
       // starting) or one of the last span (a vibration).
-      const bool clear = e_.onset_last >= kRestMotionFitFactor * fit_noise ||
-                         std::max(e_.peak, e_.peak_before) >= kRestOnsetFactor * fit_noise;
-      e_.motion_var = e_.mean_square < threshold * fit_noise || !clear ? 0.0 : e_.mean_square - fit_noise;
+      const bool clear = e_.onset_last >= kRestMotionFitFactor * rest_fit_noise ||
+                         std::max(e_.peak, e_.peak_before) >= kRestOnsetFactor * rest_fit_noise;
+      e_.motion_var = e_.mean_square < threshold * rest_fit_noise || !clear ? 0.0 : e_.mean_square - fit_noise;
     } else {
       e_.motion_var = std::max({motion_floor(fit_noise), e_.mean_square - fit_noise, e_.bias_motion});
     }
     // The fast part counts where it stands clear of the noise its fit lets through.
-    if (short_span_ > 0 && e_.short_mean_square > kFastMotionFactor * short_noise)
+    const double fast_noise = (e_.at_rest ? e_.rest_noise_var : e_.noise_var) * short_fit_noise_gain_;
+    if (short_span_ > 0 && e_.short_mean_square > kFastMotionFactor * fast_noise)
       e_.motion_var = std::max(e_.motion_var, e_.short_mean_square - short_noise);
   }
   return refreshed || ready() != was_ready;

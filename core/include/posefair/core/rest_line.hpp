@@ -53,8 +53,9 @@ class RestLine {
   void reset();
   bool empty() const { return weights_[0] == 0.0; }
   // A sample y (one channel's coordinate from the rest's first sample) taken dt
-  // seconds after the last one.
-  void add(double dt, const Vec3& y, double memory_s);
+  // seconds after the last one, weighing `weight` (its noise variance 1/weight times the
+  // others': a sample taken in a burst of noise, FairingWindow).
+  void add(double dt, const Vec3& y, double memory_s, double weight = 1.0);
   // The still pose `age` seconds before the newest sample (negative: after it, a prediction):
   // the line's value moved toward the level (kLevelBiasFactor), and whether the line is
   // straight: whether the quadratic's value there differs from the line's by less than `factor`

@@ -30,7 +30,9 @@
 // strikes by hand with β: fast motion gets little smoothing (no lag, no clamping), slow motion
 // a lot. Every input is per sample; the time constants are in seconds, so streams of any rate
 // behave alike. No allocation after construction.
+#include <algorithm>
 #include <array>
+#include <cstdint>
 #include <limits>
 #include <span>
 #include <vector>
@@ -81,6 +83,7 @@ struct NoiseDifference {
   int order = 0;
   std::array<double, 8> weights{};  // k ≤ m + 2 + MotionNoiseEstimator::kNoiseOrderAbove = 8
   double sigma_per_median = 0.0;
+  double var_per_square = 0.0;  // σ² per unit of the mean square of its length under white noise
 };
 
 // Noise and motion of one channel (rotation or position), from its differences ζ.
@@ -216,6 +219,18 @@ class MotionNoiseEstimator {
   static constexpr int kNoiseFarSamples = 6;
   static constexpr double kNoiseFarFactor = 2.0;
   static constexpr double kNoiseRunStepCap = 0.1;
+  // Even so the median follows a risen noise only within a second, and at rest each burst of
+  // noise (five times the noise for a second) was taken for a motion: its first samples stood
+  // over the rest onset and the rest line's slope over the leave threshold, and the stream was
+  // smoothed at the motion's few Hz until the rest was seen again (a still tracker kept 0.62 of
+  // raw's error at 60 Hz, where One Euro at 0.25 Hz keeps 0.24). Where most of the newest
+  // kRecentNoiseSamples lengths, at both orders, stand kNoiseFarFactor times above their median,
+  // the noise has risen, and their mean square (a running mean of weight kRecentNoiseWeight)
+  // says by how much: a rest is judged against that (rest_noise_variance). A sample off the rest
+  // line is still judged against the median's: a motion starting in a burst would otherwise go
+  // out smoothed until it stood beyond the burst's noise (docs/engine.md, "A noise burst at rest").
+  static constexpr int kRecentNoiseSamples = 9;
+  static constexpr double kRecentNoiseWeight = 0.2;
 
   // What the estimator has learnt from the stream (its weights aside, which configure() sets):
   // small and copyable, so that a window can put it back as it was before a sample it took
@@ -229,10 +244,13 @@ class MotionNoiseEstimator {
       double log_median = 0.0;
       int run = 0;  // lengths in a row above the median (> 0) or below it (< 0)
       int far_run = 0;  // lengths in a row kNoiseFarFactor times above it (> 0) or below (< 0)
+      std::uint32_t recent_far = 0;  // bit i: the (i + 1)-th newest length stood kNoiseFarFactor times above it
+      double recent_square = 0.0;    // the lengths' squares, a running mean (kRecentNoiseWeight)
       bool settled() const { return count >= static_cast<int>(first_lengths.size()); }
     };
     LengthMedian low, high;
     double noise_var = 0.0;
+    double rest_noise_var = 0.0;  // σ² a rest is judged against (rest_noise_variance)
     // Motion: the fit's mean square, the stream time since it was last taken, and d².
     double mean_square = 0.0;
     bool motion_ready = false;
@@ -287,6 +305,9 @@ class MotionNoiseEstimator {
   // stopped those clear of it. A rest line begun now takes these.
   int rest_span() const { return e_.line_clear > 0 ? e_.line_clear : line_span_; }
   double noise_variance() const { return e_.noise_var; }    // σ², per component, per sample
+  // σ² a rest is judged against: the noise's, or where it has risen lately, the newest samples'
+  // (kRecentNoiseSamples).
+  double rest_noise_variance() const { return std::max(e_.rest_noise_var, e_.noise_var); }
   double motion_variance() const { return e_.motion_var; }  // d², per component, per sample^(2m)
   int span() const { return span_; }
 
@@ -299,6 +320,8 @@ class MotionNoiseEstimator {
   // The least motion assumed while moving: the noise the fit lets through, or less where the
   // window's fit sees the motion is smaller.
   double motion_floor(double fit_noise) const;
+  // σ² of the newest samples where the noise has risen lately (kRecentNoiseSamples), or 0.
+  double recent_noise_var() const;
   // The fit over the newest half span of the samples' running median of three, its mean square.
   double newest_half_fit_of_medians(std::span<const Vec3> zeta) const;
 
