@@ -106,9 +106,12 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
                 st.rate_hz > 0 ? 1000.0 * c.lag / st.rate_hz : 0.0, 1e3 * c.horizon_s, c.continuity,
                 c.bound == BoundPolicy::Sample ? "sample" : "window");
     auto channel = [&](const char* name, const ChannelAdaptation& a, const char* unit) {
+      // The noise a rest is judged against, where the newest samples' has risen (docs/engine.md).
+      char risen[48] = "";
+      if (a.rest_noise > a.noise) std::snprintf(risen, sizeof risen, " (risen to %.3g lately)", a.rest_noise);
       if (a.adaptive)
-        std::printf("%s adapted: noise %.3g %s, motion %.3g %s/s^%d, mu %.4g (cutoff %.3g Hz)%s%s at the end\n", name, a.noise,
-                    unit, a.motion, unit, c.order, a.smoothing, a.cutoff_hz,
+        std::printf("%s adapted: noise %.3g %s%s, motion %.3g %s/s^%d, mu %.4g (cutoff %.3g Hz)%s%s at the end\n", name, a.noise,
+                    unit, risen, a.motion, unit, c.order, a.smoothing, a.cutoff_hz,
                     a.noise_scale < 1.0 ? (", chosen for noise^2/" + std::to_string(std::lround(1.0 / a.noise_scale)) + " (predicted)").c_str() : "",
                     a.rest_averaged ? ", at rest, averaged over seconds," : a.at_rest ? ", at rest," : "");
       else

@@ -589,6 +589,7 @@ EngineState FairingWindow::state() const {
     if (ch.adaptive) {
       const MotionNoiseEstimator& estimator = rotation && aided_ ? aided_estimator_ : ch.estimator;
       out.noise = unit * std::sqrt(3.0 * estimator.noise_variance());
+      out.rest_noise = unit * std::sqrt(3.0 * estimator.rest_noise_variance());
       out.at_rest = estimator.at_rest();
       out.motion = dt > 0.0 ? unit * std::sqrt(3.0 * estimator.motion_variance()) / std::pow(dt, config_.order) : 0.0;
       out.rest_averaged = ch.rest.averaged;

@@ -33,6 +33,7 @@ std::string channel(const ChannelAdaptation& c) {
   return JsonObject()
       .add("adaptive", c.adaptive)
       .number("noise", c.noise)
+      .number("rest_noise", c.rest_noise)
       .number("motion", c.motion)
       .number("smoothing", c.smoothing)
       .number("cutoff_hz", c.cutoff_hz)

@@ -94,6 +94,7 @@ void store_engine_state(StreamCounters& c, const EngineState& e) {
     to.at_rest.store(from.at_rest, relaxed);
     to.rest_averaged.store(from.rest_averaged, relaxed);
     to.noise_scale.store(from.noise_scale, relaxed);
+    to.rest_noise.store(from.rest_noise, relaxed);
   }
   c.gyro.active.store(e.gyro.active, relaxed);
   c.gyro.offset_estimated.store(e.gyro.offset_estimated, relaxed);
@@ -121,6 +122,7 @@ EngineState load_engine_state(const StreamCounters& c) {
     to.at_rest = from.at_rest.load(relaxed);
     to.rest_averaged = from.rest_averaged.load(relaxed);
     to.noise_scale = from.noise_scale.load(relaxed);
+    to.rest_noise = from.rest_noise.load(relaxed);
   }
   e.gyro.active = c.gyro.active.load(relaxed);
   e.gyro.offset_estimated = c.gyro.offset_estimated.load(relaxed);

@@ -60,6 +60,15 @@ const char* rest_text(const ChannelAdaptation& a) {
   return a.rest_averaged ? ", at rest, averaged over seconds" : a.at_rest ? ", at rest" : "";
 }
 
+// The noise a rest is judged against, where the newest samples' has risen over the estimate (a
+// burst of noise, docs/engine.md "A noise burst at rest"): " (risen to 0.006 lately)".
+std::string risen_text(const ChannelAdaptation& a) {
+  if (!(a.rest_noise > a.noise)) return {};
+  char buf[48];
+  std::snprintf(buf, sizeof buf, " (risen to %.3g lately)", a.rest_noise);
+  return buf;
+}
+
 // The noise the level is chosen for, where the check by the next measurement took less than the
 // estimate (docs/engine.md, "Checked by the next measurement"): " (chosen for noise/1024, predicted)".
 std::string scale_text(const ChannelAdaptation& a) {
@@ -81,8 +90,9 @@ std::string engine_text(const EngineState& e, const std::optional<GyroPairingSta
   text += buf;
   auto channel = [&](const char* name, const ChannelAdaptation& a, const char* unit) {
     if (a.adaptive)
-      std::snprintf(buf, sizeof buf, ", %s adapted: noise %.3g %s, motion %.3g %s/s^m, cutoff %.3g Hz (mu %.4g)%s%s", name,
-                    a.noise, unit, a.motion, unit, a.cutoff_hz, a.smoothing, scale_text(a).c_str(), rest_text(a));
+      std::snprintf(buf, sizeof buf, ", %s adapted: noise %.3g %s%s, motion %.3g %s/s^m, cutoff %.3g Hz (mu %.4g)%s%s", name,
+                    a.noise, unit, risen_text(a).c_str(), a.motion, unit, a.cutoff_hz, a.smoothing, scale_text(a).c_str(),
+                    rest_text(a));
     else
       std::snprintf(buf, sizeof buf, ", %s fixed: cutoff %.3g Hz (mu %.4g)", name, a.cutoff_hz, a.smoothing);
     text += buf;

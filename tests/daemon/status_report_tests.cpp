@@ -239,6 +239,14 @@ TEST(StatusReport, CounterLineAndStatusCarryTheEngineAdaptation) {
   EXPECT_NE(status_line({s}, {}, 1.0).find(" fc 0.11Hz (adapted, at rest)"), std::string::npos) << status_line({s}, {}, 1.0);
   EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("cutoff_hz":0.11,"at_rest":true,"rest_averaged":false,"noise_scale":1})"), std::string::npos)
       << streams_member({s}, {}, 1.0);
+  // A burst of noise at rest: the noise the rest is judged against, where it has risen over the
+  // estimate (docs/engine.md, "A noise burst at rest"), in the counter line and the control reply.
+  s.engine.rotation.rest_noise = 0.006;
+  const auto risen = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(risen[0].find("rotation adapted: noise 0.0012 rad (risen to 0.006 lately), motion 0 rad/s^m"), std::string::npos) << risen[0];
+  EXPECT_NE(streams_member({s}, {}, 1.0).find(R"("rest_noise":0.0060000000000000001,"motion":0)"), std::string::npos) << streams_member({s}, {}, 1.0);
+  s.engine.rotation.rest_noise = 0.0012;
+  EXPECT_EQ(counter_lines({s}, {}, 0.0)[0].find("risen"), std::string::npos);
   // Averaged over seconds by the rest line (docs/engine.md, "At rest"): said in all three.
   s.engine.rotation.rest_averaged = true;
   const auto averaged = counter_lines({s}, {}, 0.0);

@@ -1223,6 +1223,19 @@ TEST(Adaptation, ANoiseBurstAtRestIsNoMotion) {
       burst_raw += std::pow(rms_error_between(s, s.input.orientation, 4.0, 5.0), 2);
       after += std::pow(rms_error_between(s, out, 5.0, 6.0), 2);
       after_raw += std::pow(rms_error_between(s, s.input.orientation, 5.0, 6.0), 2);
+      // The state says what the rest was judged against: the burst's noise in it (more than
+      // twice the estimate's), the estimate's before.
+      if (seed == 1) {
+        double before = 0.0, in = 0.0;
+        each_default_pose(s, [&](std::size_t i, const FairedPose&, const FairingWindow& w) {
+          const ChannelAdaptation& a = w.state().rotation;
+          const double t = s.input.time[i];
+          if (t >= 2.0 && t < 4.0) before = std::max(before, a.rest_noise / a.noise);
+          if (t >= 4.2 && t < 5.0) in = std::max(in, a.rest_noise / a.noise);
+        });
+        EXPECT_EQ(before, 1.0);
+        EXPECT_GT(in, 2.0);
+      }
       const Stream t = still_with_a_noise_burst(c.rate, true, seed);
       turn += std::pow(rms_error_between(t, fair_causal(t.input, WindowConfig{}).poses.orientation, 4.3, 4.8), 2);
       turn_raw += std::pow(rms_error_between(t, t.input.orientation, 4.3, 4.8), 2);

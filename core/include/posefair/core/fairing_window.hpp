@@ -150,6 +150,10 @@ struct ChannelAdaptation {
   // adapted at lag 0: the factor on the noise variance that the check by the next measurement
   // took (prediction_check.hpp); 1 where the noise estimate stands
   double noise_scale = 1.0;
+  // adapted: the noise a rest is judged against (same unit as noise): the newest samples' where
+  // it has risen over the estimate lately (a burst of noise, smoothing_adaptation.hpp
+  // kRecentNoiseSamples), else the estimate's
+  double rest_noise = 0.0;
 };
 struct EngineState {
   double rate_hz = 0.0;    // given or measured; 0 until known (the source's while repeating)

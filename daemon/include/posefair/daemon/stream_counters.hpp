@@ -47,6 +47,7 @@ struct StreamCounters {
     std::atomic<bool> adaptive{false}, at_rest{false}, rest_averaged{false};
     std::atomic<double> noise{0.0}, motion{0.0}, smoothing{0.0}, cutoff_hz{0.0};
     std::atomic<double> noise_scale{1.0};
+    std::atomic<double> rest_noise{0.0};
   };
   std::atomic<double> engine_rate_hz{0.0};
   std::atomic<int> engine_window{0};
