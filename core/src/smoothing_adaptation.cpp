@@ -175,7 +175,7 @@ void MotionNoiseEstimator::update_median(Estimates::LengthMedian& m, double leng
 }
 
 double MotionNoiseEstimator::recent_noise_var() const {
-  // Not where the newest lengths reach past the motion fit's span (under 32 Hz with the
+  // Not where the newest lengths reach past the motion fit's span (under 30 Hz with the
   // defaults): there a quick turn lasts a few samples and fills most of them.
   if (kRecentNoiseSamples > span_ + 1) return 0.0;
   auto recent = [](const Estimates::LengthMedian& m, const NoiseDifference& d) {
@@ -392,7 +392,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
       // starting) or one of the last span (a vibration).
       const bool clear = e_.onset_last >= kRestMotionFitFactor * rest_fit_noise ||
                          std::max(e_.peak, e_.peak_before) >= kRestOnsetFactor * rest_fit_noise;
-      e_.motion_var = e_.mean_square < threshold * rest_fit_noise || !clear ? 0.0 : e_.mean_square - fit_noise;
+      e_.motion_var = e_.mean_square < threshold * rest_fit_noise || !clear ? 0.0 : e_.mean_square - rest_fit_noise;
     } else {
       e_.motion_var = std::max({motion_floor(fit_noise), e_.mean_square - fit_noise, e_.bias_motion});
     }
