@@ -708,7 +708,12 @@ FairingWindow::Departure FairingWindow::departs_from_rest(Channel& ch) {
     return Departure::None;
   }
   ch.rest.departure = e;
-  const bool moving = e.dot(before) > 0.5 * before.squaredNorm();
+  // Two in a row on one side are a motion starting. Where the noise has risen lately (a burst,
+  // which puts two in a row on one side about one time in five), only if their mean stands beyond
+  // that noise too (as a mean of two, half its variance): each such pair went out as measured.
+  const double risen = ch.estimator.rest_noise_variance();
+  const bool moving = e.dot(before) > 0.5 * before.squaredNorm() &&
+                      (!(risen > ch.estimator.noise_variance()) || off_beyond_noise(0.5 * (e + before), 0.5 * risen));
   judged(moving);
   if (moving) return Departure::Moving;
   d.first_off_time = time;

@@ -227,8 +227,10 @@ class MotionNoiseEstimator {
   // kRecentNoiseSamples lengths, at both orders, stand kNoiseFarFactor times above their median,
   // the noise has risen, and their mean square (a running mean of weight kRecentNoiseWeight)
   // says by how much: a rest is judged against that (rest_noise_variance). A sample off the rest
-  // line is still judged against the median's: a motion starting in a burst would otherwise go
-  // out smoothed until it stood beyond the burst's noise (docs/engine.md, "A noise burst at rest").
+  // line is still judged against the median's, and two in a row on one side go out as measured
+  // where their mean stands beyond the risen noise: a motion starting in a burst would otherwise
+  // go out at the still pose until each sample stood beyond it (docs/engine.md, "A noise burst
+  // at rest").
   static constexpr int kRecentNoiseSamples = 9;
   static constexpr double kRecentNoiseWeight = 0.2;
 
