@@ -167,6 +167,12 @@ void MotionNoiseEstimator::update_median(Estimates::LengthMedian& m, double leng
     m.far_run = from_median > far ? std::max(m.far_run, 0) + 1 : from_median < -far ? std::min(m.far_run, 0) - 1 : 0;
     m.recent_far = (m.recent_far << 1) | (from_median > far ? 1u : 0u);
     m.recent_square += kRecentNoiseWeight * (length * length - m.recent_square);
+    m.recent_above = (m.recent_above << 1) | (above ? 1u : 0u);
+    // Risen where most of the newest lengths stand far above the median, and while most stand
+    // above it: the median catching up on a burst (within a second) is not the burst's end.
+    const std::uint32_t newest = (1u << kRecentNoiseSamples) - 1u;
+    const auto most = [](std::uint32_t bits) { return 2 * std::popcount(bits) > kRecentNoiseSamples; };
+    m.risen = most(m.recent_far & newest) || (m.risen && most(m.recent_above & newest));
     double step = std::min(0.5, 0.5 * dt / settings_.noise_time_s);
     const int beyond = std::max(std::abs(m.run) - kNoiseRunSamples, std::abs(m.far_run) - kNoiseFarSamples);
     if (beyond > 0) step = std::max(step, std::min(kNoiseRunStepCap, std::ldexp(step, std::min(beyond, 60))));
@@ -179,8 +185,7 @@ double MotionNoiseEstimator::recent_noise_var() const {
   // defaults): there a quick turn lasts a few samples and fills most of them.
   if (kRecentNoiseSamples > span_ + 1) return 0.0;
   auto recent = [](const Estimates::LengthMedian& m, const NoiseDifference& d) {
-    const int far = std::popcount(m.recent_far & ((1u << kRecentNoiseSamples) - 1u));
-    return m.settled() && 2 * far > kRecentNoiseSamples ? m.recent_square * d.var_per_square : 0.0;
+    return m.settled() && m.risen ? m.recent_square * d.var_per_square : 0.0;
   };
   double v = recent(e_.low, low_);
   // Both orders, as the tracked σ: a motion at a third of the rate fills the lower one.
