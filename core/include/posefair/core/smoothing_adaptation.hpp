@@ -234,6 +234,7 @@ class MotionNoiseEstimator {
   // go out at the still pose until each sample stood beyond it (docs/engine.md, "A noise burst
   // at rest").
   static constexpr int kRecentNoiseSamples = 9;
+  static_assert(kRecentNoiseSamples < 32, "the newest lengths are bits of a std::uint32_t");
   static constexpr double kRecentNoiseWeight = 0.2;
 
   // What the estimator has learnt from the stream (its weights aside, which configure() sets):
