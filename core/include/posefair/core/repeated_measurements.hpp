@@ -10,26 +10,21 @@
 // measurements alone and carries each repeat forward from the poses before it.
 //
 // Exact repeats also come from a quantised sensor whose value did not change, at random: those
-// are measurements. They are told apart by regularity: a source read at a steady rate repeats
-// each measurement nearly the same number of times (⌊f/f_s⌋ or one more), and a stream is taken
-// as repeating its source only after kRepeatBlocks blocks of kRepeatBlockRuns measurements in
-// a row whose runs (a measurement and its repeats) average at least kMinMeanRun samples and are
-// either steady (every run within a spread of the shortest) or jittered (a source whose reports
-// come a little early or late: at most one run of a single sample, and the runs' standard
-// deviation within a third of their mean). Chance repeats seldom pass. The steady rule: with a
+// are measurements. They are told apart by regularity (regular_runs.hpp): a source read at a
+// steady rate repeats each measurement nearly the same number of times (⌊f/f_s⌋ or one more), and
+// a stream is taken as repeating its source only where its runs (a measurement and its repeats)
+// come regularly and average at least kMinMeanRun samples. Chance repeats seldom pass. The steady rule: with a
 // repeat 1 time in 3, 64 runs all of 1 or 2 samples come once in 1900, and each block's 32 of
 // them half 2s once in 500 more (about once in 10⁹ pairs of blocks). The jittered rule hardly
 // ever: their runs of one sample are common (half of them at a repeat 1 time in 2, a fifth at 4
-// in 5), and their runs spread about as widely as their mean (a geometric length's). One block
-// that fails ends it, and so does one run far longer than the block's longest (a tracker that
-// stalled repeats its last report).
+// in 5), and their runs spread about as widely as their mean (a geometric length's). A tracker
+// that stalled repeats its last report: a run far longer than the block's longest.
 // No allocation; O(1) per sample.
+#include "posefair/core/regular_runs.hpp"
 #include "posefair/core/sample.hpp"
 
 namespace posefair {
 
-inline constexpr int kRepeatBlockRuns = 32;
-inline constexpr int kRepeatBlocks = 2;
 inline constexpr double kMinMeanRun = 1.5;
 
 class RepeatedMeasurements {
@@ -39,20 +34,15 @@ class RepeatedMeasurements {
   // measured anew each time).
   bool note(const Sample& s);
   // Whether the stream repeats its measurements (above): its rate is its source's.
-  bool repeating() const { return repeating_; }
+  bool repeating() const { return runs_.regular(); }
 
  private:
-  void end_run();
   bool have_ = false;
   Quat orientation_ = Quat::Identity();
   Vec3 position_ = Vec3::Zero();
   std::uint32_t flags_ = 0;
   int run_ = 0;  // samples in the current run: the measurement and its repeats so far
-  int runs_ = 0, shortest_ = 0, longest_ = 0;
-  long samples_ = 0, squares_ = 0;  // Σ run and Σ run² over this block's runs
-  int singles_ = 0;                 // this block's runs of one sample
-  int blocks_ = 0;    // regular blocks in a row
-  bool repeating_ = false;
+  RegularRuns runs_{kMinMeanRun};
 };
 
 }  // namespace posefair
