@@ -119,7 +119,7 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
     };
     channel("rotation", st.rotation, "rad");
     if (in.has_position()) channel("position", st.position, "units");
-    std::printf("samples  %llu emitted, %llu clamped to the bound, %llu restarts after gaps, changes of rate or of repeating (%llu for a "
+    std::printf("samples  %llu emitted, %llu clamped to the bound, %llu restarts after gaps, changes of rate, of repeating or slerping (%llu for a "
                 "change of rate), %llu dropped, %llu rejected\n",
                 static_cast<unsigned long long>(r.counters.emitted), static_cast<unsigned long long>(r.counters.clamped),
                 static_cast<unsigned long long>(r.counters.restarts), static_cast<unsigned long long>(r.counters.rate_changes),
@@ -133,6 +133,12 @@ int run_causal(const FairOptions& o, const formats::PoseFile& file) {
                   "carried forward from the poses before; %s\n",
                   static_cast<unsigned long long>(r.counters.repeated),
                   st.repeating ? "the window holds the measurements alone, at the source's rate" : "not repeating at the end");
+    if (r.counters.interpolated > 0)
+      std::printf("slerped  %llu samples on the lines between measurements of a slower source (a slerped stream), "
+                  "interpolated between the poses faired for %llu measurements found on them; %s\n",
+                  static_cast<unsigned long long>(r.counters.interpolated),
+                  static_cast<unsigned long long>(r.counters.slerp_measurements),
+                  st.slerped ? "the window holds the measurements alone, at the source's rate" : "not slerped at the end");
     const double threshold = outlier_threshold(c);
     if (threshold > 0.0)
       std::printf("outliers %llu held at the prediction (threshold %g%s), %llu of them released as a motion's start\n",

@@ -576,6 +576,7 @@ EngineState FairingWindow::state() const {
   s.rate_hz = rate_;
   s.window = w_;
   s.repeating = repeating_;
+  s.slerped = slerped_;
   const double dt = rate_ > 0.0 ? 1.0 / rate_ : 0.0;
   s.gyro = gyro_.state(aided_);
   for (const bool rotation : {true, false}) {
@@ -961,14 +962,16 @@ int FairingWindow::start_afresh(std::span<FairedPose> out) {
 
 // The motion of the window's last two poses, carried on to the repeat's time, for at most one
 // interval of the source (a repeat later than that is a source that stalled: held, not
-// extrapolated). Bounded by ε around the measurement, as every pose.
+// extrapolated); a slerped sample before the newest pose's time, interpolated between the two.
+// Bounded by ε around the measurement, as every pose.
 FairedPose FairingWindow::carry_forward(const Sample& s) {
-  ++counters_.repeated;
   const WindowPoses& w = window_poses_;
-  Quat q = w.orientation[1];
-  Vec3 p = w.position[1];
+  // None yet, or one ahead of the sample (a slerped stream's start): as measured.
+  const bool measured = w.count == 0 || (w.count == 1 && s.time < w.time[1]);
+  Quat q = measured ? s.orientation : w.orientation[1];
+  Vec3 p = measured ? s.position : w.position[1];
   if (w.count >= 2 && w.time[1] > w.time[0]) {
-    const double ahead = std::min(s.time - w.time[1], typical_interval()) / (w.time[1] - w.time[0]);
+    const double ahead = std::max(std::min(s.time - w.time[1], typical_interval()) / (w.time[1] - w.time[0]), -1.0);
     q = (q * so3::exp(ahead * so3::log(w.orientation[0].conjugate() * q))).normalized();
     p += ahead * (p - w.position[0]);
   }
@@ -987,8 +990,9 @@ FairedPose FairingWindow::carry_forward(const Sample& s) {
   out.measured = s.orientation;
   out.measured_position = s.position;
   out.flags = s.flags | (clamped ? kClamped : 0u);
-  out.step = s.time - (carried_time_ >= 0.0 ? carried_time_ : w.time[1]);
+  out.step = s.time - (carried_time_ >= 0.0 ? carried_time_ : afresh_from_ >= 0.0 ? afresh_from_ : w.time[1]);
   carried_time_ = s.time;
+  afresh_from_ = -1.0;
   return out;
 }
 
@@ -1012,18 +1016,67 @@ void FairingWindow::note_window_pose(FairedPose& pose, double time) {
 int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   // A stream read faster than its source updates repeats each measurement: the window takes the
   // measurements alone (their rate is the source's) and each repeat is carried forward
-  // (repeated_measurements.hpp).
+  // (repeated_measurements.hpp). One slerped from a slower source holds its measurements on the
+  // lines between them: the window takes those, and each sample is interpolated between the
+  // poses faired for them (slerped_measurements.hpp).
   int count = 0;
   const bool repeat = repeats_.note(sample);
-  if (carries_repeats() && repeats_.repeating() != repeating_) {
-    repeating_ = repeats_.repeating();
-    count = start_afresh(out);
+  SlerpKnot next;
+  const bool confirmed = slerps_.note(sample, next);
+  if (carries_repeats()) {
+    const bool repeating = repeats_.repeating();
+    const bool slerped = !repeating && slerps_.slerped();
+    if (repeating != repeating_ || slerped != slerped_) {
+      repeating_ = repeating;
+      slerped_ = slerped;
+      count = start_afresh(out);
+    }
   }
   if (repeating_ && repeat && window_poses_.count > 0 && sample.time > last_time_ &&
       sample.time - last_time_ <= config_.gate.gap_threshold) {
+    ++counters_.repeated;
     out[static_cast<std::size_t>(count++)] = carry_forward(sample);
     return count;
   }
+  // A sample the gate would not accept goes to it, to be counted and dropped.
+  const bool sound = std::isfinite(sample.time) && sample.time > slerp_time_ && sample.orientation.coeffs().allFinite() &&
+                     std::abs(sample.orientation.norm() - 1.0) <= config_.gate.unit_tolerance &&
+                     (!sample.has_position() || sample.position.allFinite());
+  if (slerped_ && sound) {
+    Sample s = sample;
+    s.orientation.normalize();
+    return count + interpolate_slerped(s, confirmed ? &next : nullptr, out.subspan(static_cast<std::size_t>(count)));
+  }
+  return count + fair(sample, out.subspan(static_cast<std::size_t>(count)));
+}
+
+// A sample of a slerped stream: the measurement it confirms (the next one, ahead of it) faired
+// first, then the sample interpolated between the poses faired for the measurements about it. The
+// measurement's own pose is not delivered (nor counted as emitted or clamped): the samples are.
+int FairingWindow::interpolate_slerped(const Sample& sample, const SlerpKnot* next, std::span<FairedPose> out) {
+  if (next != nullptr && next->time > last_time_) {
+    Sample m = sample;
+    m.time = next->time;
+    m.orientation = next->orientation;
+    m.position = next->position;
+    std::array<FairedPose, 1> measurement_pose;  // at lag 0 (carries_repeats) one pose per sample at most
+    const WindowCounters counted = counters_;
+    const double carried = carried_time_, afresh = afresh_from_;
+    fair(m, measurement_pose);
+    counters_.emitted = counted.emitted;
+    counters_.clamped = counted.clamped;
+    ++counters_.slerp_measurements;
+    carried_time_ = carried;  // the delivered poses' steps are from the sample before
+    afresh_from_ = afresh;
+  }
+  ++counters_.interpolated;
+  slerp_time_ = sample.time;
+  out[0] = carry_forward(sample);
+  return 1;
+}
+
+int FairingWindow::fair(const Sample& sample, std::span<FairedPose> out) {
+  int count = 0;
   Sample s = sample;
   const GateVerdict verdict = gate_.check(s);
   if (verdict != GateVerdict::Accept && verdict != GateVerdict::AcceptAfterGap) return count;

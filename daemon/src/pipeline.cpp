@@ -83,6 +83,7 @@ void store_engine_state(StreamCounters& c, const EngineState& e) {
   c.engine_rate_hz.store(e.rate_hz, relaxed);
   c.engine_window.store(e.window, relaxed);
   c.engine_repeating.store(e.repeating, relaxed);
+  c.engine_slerped.store(e.slerped, relaxed);
   for (const bool rotation : {true, false}) {
     const ChannelAdaptation& from = rotation ? e.rotation : e.position;
     StreamCounters::Channel& to = rotation ? c.rotation : c.position;
@@ -111,6 +112,7 @@ EngineState load_engine_state(const StreamCounters& c) {
   e.rate_hz = c.engine_rate_hz.load(relaxed);
   e.window = c.engine_window.load(relaxed);
   e.repeating = c.engine_repeating.load(relaxed);
+  e.slerped = c.engine_slerped.load(relaxed);
   for (const bool rotation : {true, false}) {
     const StreamCounters::Channel& from = rotation ? c.rotation : c.position;
     ChannelAdaptation& to = rotation ? e.rotation : e.position;
@@ -528,6 +530,7 @@ bool Pipeline::stream_pass(Stream& s) {
   s.counters.restarts.store(w.restarts, std::memory_order_relaxed);
   s.counters.rate_changes.store(w.rate_changes, std::memory_order_relaxed);
   s.counters.repeated.store(w.repeated, std::memory_order_relaxed);
+  s.counters.interpolated.store(w.interpolated, std::memory_order_relaxed);
   s.counters.lost.store(w.lost, std::memory_order_relaxed);
   s.counters.gyro.bridged.store(w.gyro_bridged, std::memory_order_relaxed);
   store_engine_state(s.counters, s.window.state());
@@ -712,6 +715,7 @@ std::vector<StreamStats> Pipeline::stats() const {
     st.restarts = get(s.counters.restarts);
     st.rate_changes = get(s.counters.rate_changes);
     st.repeated = get(s.counters.repeated);
+    st.interpolated = get(s.counters.interpolated);
     st.lost = get(s.counters.lost);
     st.gyro_bridged = get(s.counters.gyro.bridged);
     st.engine = load_engine_state(s.counters);

@@ -152,6 +152,11 @@ std::vector<std::string> counter_lines(const std::vector<StreamStats>& now, cons
                     s.engine.repeating ? "the rate is the source's" : "not repeating now");
       lines.back() += buf;
     }
+    if (s.interpolated > 0) {  // a stream slerped from a slower source (slerped_measurements.hpp)
+      std::snprintf(buf, sizeof buf, ", interpolated %" PRIu64 " (between its measurements; %s)", s.interpolated,
+                    s.engine.slerped ? "the rate is the source's" : "not slerped now");
+      lines.back() += buf;
+    }
     if (s.lost > 0) {  // lost packets: steps of a few intervals, not gaps (fairing_window.hpp, kLostStepTolerance)
       std::snprintf(buf, sizeof buf, ", lost %" PRIu64 " (stood in for)", s.lost);
       lines.back() += buf;
@@ -211,8 +216,8 @@ std::string status_line(const std::vector<StreamStats>& now, const std::vector<S
                     : r.noise_scale < 1.0    ? " (adapted, predicted)"
                                              : " (adapted)");
       out += buf;
-      if (s.engine.repeating) {
-        std::snprintf(buf, sizeof buf, " source %.3gHz (repeated)", s.engine.rate_hz);
+      if (s.engine.repeating || s.engine.slerped) {
+        std::snprintf(buf, sizeof buf, " source %.3gHz (%s)", s.engine.rate_hz, s.engine.repeating ? "repeated" : "slerped");
         out += buf;
       }
     }

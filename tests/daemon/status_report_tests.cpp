@@ -104,6 +104,26 @@ TEST(StatusReport, RepeatsCarriedForwardShowWithTheSourcesRate) {
   EXPECT_EQ(status_line({s}, {}, 1.0).find("source"), std::string::npos);
 }
 
+// A stream slerped from a slower source (slerped_measurements.hpp): its interpolated samples show
+// as the repeats do, and STATUS= gives the source's rate while it is slerped.
+TEST(StatusReport, InterpolatedSamplesShowWithTheSourcesRate) {
+  StreamStats s = stream(1, "head", 2000);
+  s.engine.rate_hz = 250.0;
+  EXPECT_EQ(counter_lines({s}, {}, 0.0)[0].find("interpolated"), std::string::npos);
+  s.interpolated = 1400;
+  s.engine.slerped = true;
+  s.engine.rate_hz = 60.0;
+  const auto lines = counter_lines({s}, {}, 0.0);
+  EXPECT_NE(lines[0].find(", interpolated 1400 (between its measurements; the rate is the source's)"), std::string::npos) << lines[0];
+  EXPECT_NE(status_line({s}, {}, 1.0).find(" source 60Hz (slerped)"), std::string::npos) << status_line({s}, {}, 1.0);
+  const std::string json = streams_member({s}, {}, 1.0);
+  EXPECT_NE(json.find("\"interpolated\":1400,"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"slerped\":true"), std::string::npos) << json;
+  s.engine.slerped = false;
+  EXPECT_NE(counter_lines({s}, {}, 0.0)[0].find(", interpolated 1400 (between its measurements; not slerped now)"), std::string::npos);
+  EXPECT_EQ(status_line({s}, {}, 1.0).find("source"), std::string::npos);
+}
+
 // [stream.engine] gyro_stream: the gyro part names the source and its matches from the start,
 // before any interval was aided, and STATUS= says how many samples found no reading.
 TEST(StatusReport, GapsBridgedAndPassedThroughShowWhenBridging) {

@@ -35,6 +35,7 @@
 #include "posefair/core/outlier_guard.hpp"
 #include "posefair/core/prediction_check.hpp"
 #include "posefair/core/repeated_measurements.hpp"
+#include "posefair/core/slerped_measurements.hpp"
 #include "posefair/core/rest_line.hpp"
 #include "posefair/core/sample.hpp"
 #include "posefair/core/sample_gate.hpp"
@@ -132,6 +133,11 @@ struct WindowCounters {
   // Samples that repeated the measurement before, in a stream read faster than its source
   // updates (repeated_measurements.hpp): carried forward from the poses before, not faired.
   std::uint64_t repeated = 0;
+  // A stream slerped from a slower source (slerped_measurements.hpp): its samples, interpolated
+  // between the poses faired for the measurements it holds, and those measurements (faired, not
+  // delivered).
+  std::uint64_t interpolated = 0;
+  std::uint64_t slerp_measurements = 0;
   // Samples lost within a step (one of two to four intervals with the default gate; a longer
   // one is a gap): stood in for on the line between their neighbours, faired across, not emitted.
   std::uint64_t lost = 0;
@@ -161,6 +167,9 @@ struct EngineState {
   // The stream repeats each measurement (read faster than its source updates): the window
   // holds the measurements alone, at the source's rate, and each repeat is carried forward.
   bool repeating = false;
+  // The stream is slerped from a slower source: the window holds the measurements it holds, at
+  // the source's rate, and each sample is interpolated between the poses faired for them.
+  bool slerped = false;
   ChannelAdaptation rotation, position;
   GyroAidingState gyro;
 };
@@ -295,6 +304,8 @@ class FairingWindow {
   void predict_from_last_step(int k, double step);
   bool carries_repeats() const;
   int start_afresh(std::span<FairedPose> out);
+  int fair(const Sample& sample, std::span<FairedPose> out);
+  int interpolate_slerped(const Sample& sample, const SlerpKnot* next, std::span<FairedPose> out);
   FairedPose carry_forward(const Sample& s);
   void note_window_pose(FairedPose& pose, double time);
   void check_continuity_stability() const;
@@ -331,6 +342,10 @@ class FairingWindow {
   // emitted (lag 0) with their samples' times, which a repeat carries forward.
   RepeatedMeasurements repeats_;
   bool repeating_ = false;  // the window holds the measurements alone, and carries the repeats
+  // A stream slerped from a slower source: what tells it and reconstructs its measurements.
+  SlerpedMeasurements slerps_;
+  bool slerped_ = false;  // the window holds the measurements alone, and interpolates the samples
+  double slerp_time_ = -std::numeric_limits<double>::infinity();  // the newest sample interpolated
   struct WindowPoses {
     std::array<Quat, 2> orientation{Quat::Identity(), Quat::Identity()};
     std::array<Vec3, 2> position{Vec3::Zero(), Vec3::Zero()};

@@ -29,6 +29,7 @@ struct StreamCounters {
   std::atomic<std::uint64_t> restarts{0};         // windows restarted after a gap or a change of rate
   std::atomic<std::uint64_t> rate_changes{0};     // of which for a change of the measured rate
   std::atomic<std::uint64_t> repeated{0};         // samples that repeated the measurement before, carried forward (repeated_measurements.hpp)
+  std::atomic<std::uint64_t> interpolated{0};     // samples of a slerped stream, interpolated between its measurements' poses (slerped_measurements.hpp)
   std::atomic<std::uint64_t> lost{0};             // samples lost within a step, stood in for in the window (not a gap)
   std::atomic<std::uint64_t> bridged_gaps{0};     // input gaps filled on the spline ([stream.spline] bridge_gap)
   std::atomic<std::uint64_t> bridged_samples{0};  // samples made for them
@@ -52,6 +53,7 @@ struct StreamCounters {
   std::atomic<double> engine_rate_hz{0.0};
   std::atomic<int> engine_window{0};
   std::atomic<bool> engine_repeating{false};  // the stream repeats its measurements: the rate is its source's
+  std::atomic<bool> engine_slerped{false};    // the stream is slerped from a slower source: the rate is its source's
   Channel rotation, position;
   // Gyro-aided fairing (EngineState::gyro): whether the window uses a gyro now, and its
   // estimated bias and time offset; with a gyro_stream, the samples that got a reading from it.
@@ -93,6 +95,7 @@ struct StreamStats {
   std::uint64_t received = 0, ring_dropped = 0, rejected = 0, out_of_order = 0, emitted = 0, clamped = 0, restarts = 0;
   std::uint64_t rate_changes = 0;  // of the restarts, for a change of the measured rate
   std::uint64_t repeated = 0;  // samples that repeated the measurement before, carried forward (repeated_measurements.hpp)
+  std::uint64_t interpolated = 0;  // samples of a slerped stream, interpolated between its measurements' poses (slerped_measurements.hpp)
   std::uint64_t lost = 0;  // samples lost within a step (a lost packet), stood in for in the window (not a gap)
   std::uint64_t outliers_held = 0, outliers_released = 0;  // the outlier guard (outlier_guard.hpp)
   std::uint64_t gyro_bridged = 0;  // gyro readings missing from an aided window, bridged (no restart)
