@@ -1022,7 +1022,7 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   int count = 0;
   const bool repeat = repeats_.note(sample);
   SlerpKnot next;
-  const bool confirmed = slerps_.note(sample, next);
+  const bool found = slerps_.note(sample, next);
   if (carries_repeats()) {
     const bool repeating = repeats_.repeating();
     const bool slerped = !repeating && slerps_.slerped();
@@ -1045,12 +1045,12 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   if (slerped_ && sound) {
     Sample s = sample;
     s.orientation.normalize();
-    return count + interpolate_slerped(s, confirmed ? &next : nullptr, out.subspan(static_cast<std::size_t>(count)));
+    return count + interpolate_slerped(s, found ? &next : nullptr, out.subspan(static_cast<std::size_t>(count)));
   }
   return count + fair(sample, out.subspan(static_cast<std::size_t>(count)));
 }
 
-// A sample of a slerped stream: the measurement it confirms (the next one, ahead of it) faired
+// A sample of a slerped stream: the measurement it shows (the next one, ahead of it) faired
 // first, then the sample interpolated between the poses faired for the measurements about it. The
 // measurement's own pose is not delivered (nor counted as emitted or clamped): the samples are.
 int FairingWindow::interpolate_slerped(const Sample& sample, const SlerpKnot* next, std::span<FairedPose> out) {

@@ -18,7 +18,7 @@ void SlerpedMeasurements::reset() {
   runs_.break_off();
 }
 
-bool SlerpedMeasurements::knot(const LinePoint& before, const LinePoint& after, SlerpKnot& at) const {
+bool SlerpedMeasurements::knot(const LinePoint& before, const LinePoint& after, SlerpKnot& at, bool& sharp) const {
   // Both lines are geodesics, the first before·exp(τ·ω_a), the second after·exp((τ − Δt)·ω_b);
   // the positions lines. Where they meet, e(τ) = log of the one's inverse times the other is zero
   // (and the positions' difference); de/dτ = ω_b − ω_a to first order in the step between them, so
@@ -42,6 +42,9 @@ bool SlerpedMeasurements::knot(const LinePoint& before, const LinePoint& after, 
   if ((e - along * turn).norm() > kContinuesWithin + kContinuesPer * step ||
       (ep - along * shift).norm() > kContinuesWithin + kContinuesPer * (after.position - before.position).norm())
     return false;  // the lines pass each other: no measurement joins them
+  // Where the kink is within what rounding allows of a straight line (a clean stream whose
+  // measurement fell near a sample), the time is not known to better than that.
+  sharp = (kContinuesWithin + kContinuesPer * step) <= kSharpKnot * span * std::sqrt(denominator);
   const double t = std::clamp(tau, 0.0, span);
   at.time = before.time + t;
   at.orientation = (before.orientation * so3::exp(t * before.rate)).normalized();
@@ -93,10 +96,21 @@ bool SlerpedMeasurements::note(const Sample& s, SlerpKnot& next) {
       first.rate = p.rate;
       first.velocity = p.velocity;
       SlerpKnot at;
-      if (knot(line_, first, at)) {
+      bool sharp = false;
+      if (knot(line_, first, at, sharp)) {
+        // A knot whose time is not sharp is where a measurement was expected (the line's value
+        // there is as good as any), and does not move the interval. A kink within rounding of
+        // none is not seen (a clean stream, now and then): the interval from the knot before is
+        // then a few of the source's.
+        if (!sharp && have_anchor_)
+          at.time = anchor_.time + std::round((at.time - anchor_.time) / interval_) * interval_;
         if (have_knot_) {  // a run from knot to knot
           const double interval = at.time - knot_time_;
-          interval_ = interval_ > 0.0 ? interval_ + kIntervalWeight * (interval - interval_) : interval;
+          const double intervals = interval_ > 0.0 ? std::max(1.0, std::round(interval / interval_)) : 1.0;
+          if (interval_ == 0.0)
+            interval_ = interval;
+          else if (sharp && std::abs(interval - intervals * interval_) <= 0.25 * interval_)
+            interval_ += kIntervalWeight * (interval / intervals - interval_);
           runs_.end_run(run_);
         }
         have_knot_ = true;

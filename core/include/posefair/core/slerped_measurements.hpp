@@ -48,6 +48,9 @@ class SlerpedMeasurements {
   // A sample this many of the stream's steps past the measurement expected (or more) finds the next
   // one: closer, the rounding of its slerp fraction would weigh too much.
   static constexpr double kMinPastKnot = 0.2;
+  // A knot's time is sharp where the two lines part by the rounding allowed within this part of
+  // the step between their samples.
+  static constexpr double kSharpKnot = 0.05;
   // The running mean of the source's interval gives the newest interval this weight.
   static constexpr double kIntervalWeight = 0.125;
 
@@ -68,7 +71,8 @@ class SlerpedMeasurements {
   void reset();
   // The knot where the line through `before` meets the line through `after` (the sample after it),
   // or false where they do not meet between the two.
-  bool knot(const LinePoint& before, const LinePoint& after, SlerpKnot& at) const;
+  // sharp: its time is known to kSharpKnot of the step between them.
+  bool knot(const LinePoint& before, const LinePoint& after, SlerpKnot& at, bool& sharp) const;
 
   bool have_ = false, have_step_ = false;
   bool positions_ = false;         // the samples have positions
