@@ -1022,7 +1022,7 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
   int count = 0;
   const bool repeat = repeats_.note(sample);
   SlerpKnot next;
-  const bool found = slerps_.note(sample, next);
+  const bool found = carries_repeats() && slerps_.note(sample, next);  // not read otherwise
   if (carries_repeats()) {
     const bool repeating = repeats_.repeating();
     const bool slerped = !repeating && slerps_.slerped();

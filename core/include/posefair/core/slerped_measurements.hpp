@@ -13,9 +13,12 @@
 // of time: the samples need not be evenly spaced), it continues a line; two equal steps in a row
 // after a change confirm a new line, which meets the line before at a knot: the measurement, at
 // the time between the last sample of the line before and the first of the new one where the two
-// are nearest. The next measurement is on the new line one source interval later (the mean of
-// the intervals between knots): a slerped sample already moves toward it, so the engine fairs
-// that one as soon as the line is confirmed, and interpolates the samples between.
+// meet. The next measurement is on the new line one source interval later (the mean of the
+// intervals between knots): a slerped sample already moves toward it, so the engine fairs that
+// one as soon as the stream shows it (the line confirmed, or before: the first sample past the
+// measurement expected), and interpolates the samples between. Under little noise a kink is now
+// and then within rounding of none: a knot whose time that leaves unsharp is put on the grid of
+// the source's intervals, and an interval over several of them (a kink unseen) counts as several.
 // A stream is taken as slerped only where its runs between confirmed lines come regularly
 // (regular_runs.hpp) and average at least kMinSlerpRun samples (a source at a third of the rate
 // or less: each run needs two equal steps after its kink), every knot lies between its two lines'
