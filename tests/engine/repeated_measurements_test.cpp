@@ -168,6 +168,22 @@ Scored score(const WindowConfig& config, const std::vector<Sample>& in, const st
   return {std::sqrt(sq), std::sqrt(sq_raw), w.counters().repeated, w.counters().interpolated, w.state()};
 }
 
+// Pushes each sample (one pose each, at lag 0), checks the pose within ε of its sample, rotation
+// and position, and returns the poses; after_each is called after each push.
+template <class AfterEach>
+std::vector<FairedPose> bounded_poses(FairingWindow& w, const WindowConfig& c, const std::vector<Sample>& in, AfterEach&& after_each) {
+  std::vector<FairedPose> out(1);
+  std::vector<FairedPose> poses;
+  for (const Sample& s : in) {
+    EXPECT_EQ(w.push(s, out), 1);
+    poses.push_back(out[0]);
+    after_each();
+    EXPECT_LE(so3::dist(out[0].orientation, out[0].measured), c.epsilon_r + 1e-12);
+    EXPECT_LE((out[0].position - out[0].measured_position).norm(), c.epsilon_t + 1e-9);
+  }
+  return poses;
+}
+
 TEST(RepeatedMeasurementsInTheEngine, AStreamReadFasterThanItsSourceIsFairedAtTheSourcesRate) {
   // Read at 250 Hz, the repeats hide the noise and the steps read as motion: the engine with
   // the stream's rate given (which keeps every sample in the window) is within 15% of raw. At the
@@ -205,16 +221,8 @@ TEST(RepeatedMeasurementsInTheEngine, ARepeatIsCarriedForwardWithinItsBoundAndIt
   c.epsilon_r = 0.004;
   c.epsilon_t = 0.4;
   FairingWindow w(c);
-  std::vector<FairedPose> out(1);
-  std::vector<FairedPose> poses;
   std::vector<char> repeating;
-  for (const Sample& s : in) {
-    ASSERT_EQ(w.push(s, out), 1);
-    poses.push_back(out[0]);
-    repeating.push_back(w.state().repeating ? 1 : 0);
-    EXPECT_LE(so3::dist(out[0].orientation, out[0].measured), c.epsilon_r + 1e-12);
-    EXPECT_LE((out[0].position - out[0].measured_position).norm(), c.epsilon_t + 1e-9);
-  }
+  const std::vector<FairedPose> poses = bounded_poses(w, c, in, [&] { repeating.push_back(w.state().repeating ? 1 : 0); });
   EXPECT_GT(w.counters().repeated, 0u);
   EXPECT_GT(w.counters().clamped, 0u);  // the bound did bind
   for (std::size_t i = 1; i < poses.size(); ++i) EXPECT_NEAR(poses[i].step, in[i].time - in[i - 1].time, 1e-9) << i;
@@ -354,14 +362,7 @@ TEST(SlerpedMeasurementsInTheEngine, EachSampleIsInterpolatedWithinItsBoundAndIt
   c.epsilon_r = 0.002;
   c.epsilon_t = 0.2;
   FairingWindow w(c);
-  std::vector<FairedPose> out(1);
-  std::vector<FairedPose> poses;
-  for (const Sample& s : in) {
-    ASSERT_EQ(w.push(s, out), 1);
-    poses.push_back(out[0]);
-    EXPECT_LE(so3::dist(out[0].orientation, out[0].measured), c.epsilon_r + 1e-12);
-    EXPECT_LE((out[0].position - out[0].measured_position).norm(), c.epsilon_t + 1e-9);
-  }
+  const std::vector<FairedPose> poses = bounded_poses(w, c, in, [] {});
   EXPECT_TRUE(w.state().slerped);
   EXPECT_GT(w.counters().interpolated, 0u);
   EXPECT_GT(w.counters().clamped, 0u);  // the bound did bind
