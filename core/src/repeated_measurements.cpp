@@ -4,10 +4,6 @@
 
 namespace posefair {
 
-namespace {
-constexpr int kLongestRun = 1 << 30;
-}  // namespace
-
 bool RepeatedMeasurements::note(const Sample& s) {
   const bool repeat = have_ && (s.flags & (kHasGyro | kHasAccel | kHasMag | kNoOrientation)) == 0 &&
                       s.flags == flags_ && s.orientation.coeffs() == orientation_.coeffs() &&

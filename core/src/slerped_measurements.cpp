@@ -7,10 +7,6 @@
 
 namespace posefair {
 
-namespace {
-constexpr int kLongestRun = 1 << 30;
-}  // namespace
-
 void SlerpedMeasurements::reset() {
   have_ = have_step_ = have_line_ = kinked_ = have_knot_ = have_anchor_ = false;
   interval_ = 0.0;

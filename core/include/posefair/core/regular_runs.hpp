@@ -15,6 +15,8 @@ namespace posefair {
 
 inline constexpr int kRepeatBlockRuns = 32;
 inline constexpr int kRepeatBlocks = 2;
+// A run's length stops counting here: a source stalled for weeks cannot overflow it.
+inline constexpr int kLongestRun = 1 << 30;
 
 class RegularRuns {
  public:
