@@ -48,6 +48,12 @@ bool SlerpedMeasurements::knot(const LinePoint& before, const LinePoint& after, 
   return true;
 }
 
+void SlerpedMeasurements::rate_of(LinePoint& p) {
+  if (p.rated) return;
+  p.rate = so3::log(p.step) / p.step_dt;
+  p.rated = true;
+}
+
 bool SlerpedMeasurements::note(const Sample& s, SlerpKnot& next) {
   if ((s.flags & (kHasGyro | kHasAccel | kHasMag | kNoOrientation)) != 0) {
     reset();  // each sample measured anew
@@ -65,11 +71,20 @@ bool SlerpedMeasurements::note(const Sample& s, SlerpKnot& next) {
     return false;
   }
   const double dt = s.time - last_.time;
-  p.rate = so3::log(last_.orientation.conjugate() * s.orientation) / dt;
+  p.step = last_.orientation.conjugate() * s.orientation;
+  p.step_dt = dt;
+  p.chord = (p.step.w() < 0.0 ? Vec3(-p.step.vec()) : Vec3(p.step.vec())) / dt;
   p.velocity = (p.position - last_.position) / dt;
-  const bool continues = have_step_ &&
-                         ((p.rate - last_.rate) * dt).norm() <= kContinuesWithin + kContinuesPer * p.rate.norm() * dt &&
-                         ((p.velocity - last_.velocity) * dt).norm() <= kContinuesWithin + kContinuesPer * p.velocity.norm() * dt;
+  // The step's vector part (sin of half its angle, per second) first, which costs no log: two that
+  // differ by twice the rounding allowed have logs that differ by more than it (to second order in
+  // the step). Most steps of a measured stream end there; the rest are compared exactly.
+  bool continues = false;
+  if (have_step_ && ((p.chord - last_.chord) * dt).norm() <= 2.0 * (kContinuesWithin + kContinuesPer * p.chord.norm() * dt)) {
+    rate_of(p);
+    rate_of(last_);
+    continues = ((p.rate - last_.rate) * dt).norm() <= kContinuesWithin + kContinuesPer * p.rate.norm() * dt &&
+                ((p.velocity - last_.velocity) * dt).norm() <= kContinuesWithin + kContinuesPer * p.velocity.norm() * dt;
+  }
   have_step_ = true;
   run_ = std::min(run_ + 1, kLongestRun);
   runs_.check_open_run(run_);  // no kink for far longer than the runs before: no longer slerped

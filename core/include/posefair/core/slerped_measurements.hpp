@@ -68,9 +68,14 @@ class SlerpedMeasurements {
     double time = 0.0;
     Quat orientation = Quat::Identity();
     Vec3 position = Vec3::Zero();
-    Vec3 rate = Vec3::Zero();      // of the orientation's log, per second (body frame)
+    Vec3 rate = Vec3::Zero();      // of the orientation's log, per second (body frame), once rated
     Vec3 velocity = Vec3::Zero();  // of the position, per second
+    Quat step = Quat::Identity();  // from the sample before, over step_dt
+    double step_dt = 1.0;
+    Vec3 chord = Vec3::Zero();     // the step's vector part, per second
+    bool rated = false;
   };
+  static void rate_of(LinePoint& p);  // its rate from its step, once
   void reset();
   // The knot where the line through `before` meets the line through `after` (the sample after it),
   // or false where they do not meet between the two.
