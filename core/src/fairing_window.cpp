@@ -1039,10 +1039,7 @@ int FairingWindow::push(const Sample& sample, std::span<FairedPose> out) {
     return count;
   }
   // A sample the gate would not accept goes to it, to be counted and dropped.
-  const bool sound = std::isfinite(sample.time) && sample.time > slerp_time_ && sample.orientation.coeffs().allFinite() &&
-                     std::abs(sample.orientation.norm() - 1.0) <= config_.gate.unit_tolerance &&
-                     (!sample.has_position() || sample.position.allFinite());
-  if (slerped_ && sound) {
+  if (slerped_ && gate_.validity(sample) == GateVerdict::Accept && sample.time > slerp_time_) {
     Sample s = sample;
     s.orientation.normalize();
     return count + interpolate_slerped(s, found ? &next : nullptr, out.subspan(static_cast<std::size_t>(count)));

@@ -22,22 +22,31 @@ void SampleGate::set_interval(double interval) {
   ahead_ = 0.0;
 }
 
-GateVerdict SampleGate::check(Sample& s) {
+GateVerdict SampleGate::validity(const Sample& s) const {
   const bool finite = std::isfinite(s.time) && s.orientation.coeffs().allFinite() &&
                       (!s.has_position() || s.position.allFinite());
-  if (!finite) {
-    ++counters_.rejected_non_finite;
-    return GateVerdict::RejectNonFinite;
+  if (!finite) return GateVerdict::RejectNonFinite;
+  const double norm = s.orientation.norm();
+  if (norm == 0.0) return GateVerdict::RejectZero;
+  if (std::abs(norm - 1.0) > config_.unit_tolerance) return GateVerdict::RejectNonUnit;
+  return GateVerdict::Accept;
+}
+
+GateVerdict SampleGate::check(Sample& s) {
+  switch (const GateVerdict v = validity(s)) {
+    case GateVerdict::RejectNonFinite:
+      ++counters_.rejected_non_finite;
+      return v;
+    case GateVerdict::RejectZero:
+      ++counters_.rejected_zero;
+      return v;
+    case GateVerdict::RejectNonUnit:
+      ++counters_.rejected_non_unit;
+      return v;
+    default:
+      break;
   }
   const double norm = s.orientation.norm();
-  if (norm == 0.0) {
-    ++counters_.rejected_zero;
-    return GateVerdict::RejectZero;
-  }
-  if (std::abs(norm - 1.0) > config_.unit_tolerance) {
-    ++counters_.rejected_non_unit;
-    return GateVerdict::RejectNonUnit;
-  }
   if (s.time == last_time_) {
     ++counters_.dropped_repeated;
     return GateVerdict::DropRepeated;

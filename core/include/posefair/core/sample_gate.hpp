@@ -54,6 +54,9 @@ class SampleGate {
   explicit SampleGate(const GateConfig& config = {});
   // Checks s; on acceptance its orientation is normalised in place.
   GateVerdict check(Sample& s);
+  // Whether s could be accepted at all, its time aside: Accept, or the reject check() would give
+  // (nothing counted).
+  GateVerdict validity(const Sample& s) const;
   // Forget the last time (a new stream), keep the counters.
   void restart() {
     last_time_ = -std::numeric_limits<double>::infinity();
