@@ -19,12 +19,14 @@ Vec3 log(const Quat& q_in) {
   const double s = v.norm();
   const double w = q.w();
   // θ = atan2(s, w) is well conditioned everywhere, including near θ = pi/2 (w -> 0).
-  // For tiny s use atan(x)/x = 1 - x²/3 + x⁴/5 with x = s/w (w ≈ |q| there) to avoid 0/0.
+  // For small s use atan(x)/x = 1 − x²/3 + x⁴/5 − x⁶/7 + x⁸/9 with x = s/w (w ≈ |q| there): it
+  // avoids 0/0, and under x = 0.01 the first term left out (x¹⁰/11) is below a double's rounding,
+  // so it is exact where most samples' steps lie, at a fraction of atan2's cost.
   double scale;
-  if (s < 1e-4 * w) {
+  if (s < 1e-2 * w) {
     const double x = s / w;
     const double x2 = x * x;
-    scale = (1.0 - x2 / 3.0 + x2 * x2 / 5.0) / w;
+    scale = (1.0 + x2 * (-1.0 / 3.0 + x2 * (1.0 / 5.0 + x2 * (-1.0 / 7.0 + x2 / 9.0)))) / w;
   } else {
     scale = std::atan2(s, w) / s;
   }
