@@ -69,11 +69,18 @@ struct LineSlope {
   Vec3 slope;
   double sxx;
 };
-LineSlope newest_line_slope(std::span<const Vec3> zeta, int samples) {
+// The weights' common divisor 2·Sxx is taken out: (j + 1)(L − 1 − j), exact integers.
+double line_weight(int samples, int j) { return (j + 1.0) * (samples - 1.0 - j); }
+void table_line_weights(int samples, std::vector<double>& out) {
+  for (int j = 0; j + 1 < samples; ++j) out[static_cast<std::size_t>(j)] = line_weight(samples, j);
+}
+// `table`: the weights for `samples`, tabled, or empty.
+LineSlope newest_line_slope(std::span<const Vec3> zeta, int samples, std::span<const double> table = {}) {
   const double l = samples, sxx = l * (l * l - 1.0) / 12.0;
-  const Vec3 v = weighted_vector_sum(0, samples - 1, [&](int j) { return (j + 1.0) * (l - 1.0 - j) / (2.0 * sxx); },
-                                     zeta.subspan(zeta.size() - static_cast<std::size_t>(samples - 1)));
-  return {v, sxx};
+  const std::span<const Vec3> differences = zeta.subspan(zeta.size() - static_cast<std::size_t>(samples - 1));
+  const Vec3 v = table.empty() ? weighted_vector_sum(0, samples - 1, [&](int j) { return line_weight(samples, j); }, differences)
+                               : weighted_vector_sum(0, samples - 1, [&](int j) { return table[static_cast<std::size_t>(j)]; }, differences);
+  return {v / (2.0 * sxx), sxx};
 }
 
 // The componentwise median of three vectors.
@@ -110,7 +117,9 @@ MotionNoiseEstimator::MotionNoiseEstimator(int capacity, int order)
       low_(noise_difference(order + 2)),
       fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
       short_fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
-      window_fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0) {}
+      window_fit_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
+      line_weights_(static_cast<std::size_t>(std::max(1, capacity)), 0.0),
+      short_line_weights_(static_cast<std::size_t>(std::max(1, capacity)), 0.0) {}
 
 void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& settings, int window) {
   settings_ = settings;
@@ -133,6 +142,8 @@ void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& s
   // on θ is 1/Σ(i − c)².
   line_span_ = std::clamp(window, 2, std::max(2, capacity_));
   line_noise_gain_ = 12.0 / (line_span_ * (static_cast<double>(line_span_) * line_span_ - 1.0));
+  table_line_weights(line_span_, line_weights_);
+  table_line_weights(short_span_, short_line_weights_);
   // The slow part's fit over the window: its m-th derivative has (W/span)^(2m+1) times less noise
   // (32 times at m = 2), so it tells a slow motion from none where the fit above cannot. Not where
   // the window's minimum of samples stretches it past twice the fit's span (under 14 Hz with the
@@ -305,7 +316,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
         const bool stopped = clear_motion && sample < kMotionStopFactor * fit_noise && std::max(h0, h1) < kMotionStopFactor * short_noise;
         bool half_stopped = false;
         if (!stopped && !half_stands_in && clear_motion && h0 < kMotionStopFactor * short_noise) {
-          const LineSlope line = newest_line_slope(zeta, short_span_);
+          const LineSlope line = newest_line_slope(zeta, short_span_, short_line_weights_);
           half_stopped = line.slope.squaredNorm() / 3.0 < kStillSlopeFactor * e_.noise_var / line.sxx;
         }
         if ((stopped || half_stopped) && e_.stop_last) {
@@ -356,8 +367,10 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
       e_.peak = std::max(e_.peak, sample);
       const bool full = n1 >= line_span_ - 1;
       if (settings_.motion_floor && window_fit_noise_gain_ > 0.0 && full) {
-        const Vec3 v = weighted_vector_sum(0, line_span_ - 1, [&](int j) { return window_fit_[static_cast<std::size_t>(j)]; },
-                                           zeta.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
+        // (Where the span is the window's, as at 1 kHz, it is the same fit as the span's.)
+        const Vec3 v = line_span_ == span_ ? d
+                                           : weighted_vector_sum(0, line_span_ - 1, [&](int j) { return window_fit_[static_cast<std::size_t>(j)]; },
+                                                                 zeta.subspan(static_cast<std::size_t>(n1 - (line_span_ - 1))));
         const double slow = v.squaredNorm() / 3.0;
         e_.window_mean_square = e_.window_ready ? e_.window_mean_square + alpha * (slow - e_.window_mean_square) : slow;
         e_.window_ready = true;
@@ -370,7 +383,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
         // that one average and one threshold serve both.
         const int clear = samples_clear_of_stop();
         const bool after_stop = e_.stopped_motion > 0.0 && clear < line_span_ && clear >= std::max(kRestLineMinSamples, span_);
-        const LineSlope line = newest_line_slope(on, after_stop ? clear : line_span_);
+        const LineSlope line = after_stop ? newest_line_slope(on, clear) : newest_line_slope(on, line_span_, line_weights_);
         double slope = line.slope.squaredNorm() / 3.0 * line_noise_gain_ * line.sxx;  // (× 1 on the window's line)
         const double leaves = kRestLeaveFactor * settings_.rest_threshold * e_.rest_noise_var * line_noise_gain_;
         slope = std::min(slope, kRestSlopeCap * leaves);

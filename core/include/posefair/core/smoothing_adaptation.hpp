@@ -353,6 +353,9 @@ class MotionNoiseEstimator {
   // Rest: a line through the newest line_span_ samples, and Σ of its slope's squared weights on θ.
   int line_span_ = 0;
   double line_noise_gain_ = 0.0;
+  // The weights of the lines through line_span_ and short_span_ samples (newest_line_slope),
+  // tabled: both are taken at every motion fit.
+  std::vector<double> line_weights_, short_line_weights_;
   Estimates e_;
 };
 
