@@ -171,7 +171,8 @@ bool emits_held_as_measured(const WindowConfig& config) {
   return config.lag == 0 && config.solver == WindowSolver::Linear;
 }
 
-FairingWindow::Channel::Channel(int capacity, int order) : fixed(make_emission_row(capacity)), estimator(capacity, order) {}
+FairingWindow::Channel::Channel(int capacity, int order)
+    : fixed(make_emission_row(capacity)), blend{std::vector<double>(static_cast<std::size_t>(std::max(1, capacity)), 0.0)}, estimator(capacity, order) {}
 
 FairingWindow::FairingWindow(const WindowConfig& config)
     : config_(config),
@@ -313,6 +314,7 @@ void FairingWindow::prepare(double rate_hz) {
         if (mu > kMaxSmoothing) break;
         builder_.build(w_, mu, target_spec_, levels_[static_cast<std::size_t>(level_count_++)]);
       }
+      rot_.blend.level = pos_.blend.level = -1.0;  // of the rows before
       if (!next_rows_.empty()) {
         // The check's predictions: each level's fit one sample past the newest.
         const EmissionTarget next{m, 0, 1.0, 0.0};
@@ -457,13 +459,20 @@ Vec3 apply_row(const EmissionRow& row, int n, std::span<const Vec3> zeta, std::s
   return e;
 }
 
-// (1 − f)·u_a + f·u_b in one pass over ζ (the adapted smoothing between two levels; no
+// The weights on ζ of (1 − f)·u_a + f·u_b (the adapted smoothing between two levels; no
 // continuity, which needs fixed smoothing).
+double blended_weight(const EmissionRow& a, const EmissionRow& b, double f, int j) {
+  return (1.0 - f) * a.zeta[static_cast<std::size_t>(j)] + f * b.zeta[static_cast<std::size_t>(j)];
+}
+
+// Those weights applied to ζ in one pass.
 Vec3 apply_rows(const EmissionRow& a, const EmissionRow& b, double f, int n, std::span<const Vec3> zeta) {
-  const double g = 1.0 - f;
-  return weighted_vector_sum(
-      std::min(a.first, b.first), n - 1,
-      [&](int j) { return g * a.zeta[static_cast<std::size_t>(j)] + f * b.zeta[static_cast<std::size_t>(j)]; }, zeta);
+  return weighted_vector_sum(std::min(a.first, b.first), n - 1, [&](int j) { return blended_weight(a, b, f, j); }, zeta);
+}
+
+// Or kept, for a level used on several samples.
+void blend_rows(const EmissionRow& a, const EmissionRow& b, double f, int n, std::vector<double>& out) {
+  for (int j = std::min(a.first, b.first); j < n - 1; ++j) out[static_cast<std::size_t>(j)] = blended_weight(a, b, f, j);
 }
 
 }  // namespace
@@ -527,7 +536,13 @@ Vec3 FairingWindow::linear_correction(Channel& ch, std::span<const Vec3> zeta, s
     const double f = ch.level - i;
     const EmissionRow& a = levels_[static_cast<std::size_t>(i)];
     if (!(f > 0.0) || i + 1 >= level_count_) return apply_row(a, n_, zeta, c, emitted, false);
-    return apply_rows(a, levels_[static_cast<std::size_t>(i + 1)], f, n_, zeta);
+    Channel::Blend& blend = ch.blend;
+    if (blend.level != ch.level) {
+      blend_rows(a, levels_[static_cast<std::size_t>(i + 1)], f, n_, blend.zeta);
+      blend.first = std::min(a.first, levels_[static_cast<std::size_t>(i + 1)].first);
+      blend.level = ch.level;
+    }
+    return weighted_vector_sum(blend.first, n_ - 1, [&](int j) { return blend.zeta[static_cast<std::size_t>(j)]; }, zeta);
   }
   // A window still filling (after the start or a gap): its row, built for this fill level.
   if (!ch.filling_moved && fill_moves(ch, zeta)) ch.filling_moved = true;
@@ -862,10 +877,11 @@ std::size_t FairingWindow::memory_bytes() const {
   bytes += next_rows_.capacity() * sizeof(EmissionRow);
   for (const EmissionRow& r : next_rows_) bytes += row_bytes(r);
   bytes += row_bytes(fill_row_) + row_bytes(fill_newest_row_) + row_bytes(rot_.fixed) + row_bytes(pos_.fixed);
+  bytes += (rot_.blend.zeta.capacity() + pos_.blend.zeta.capacity()) * sizeof(double);
   // The builder's band matrix and scratch, and the three estimators' fit, half-span fit, window
-  // fit and line weights.
+  // fit and the two lines' weights (newest_line_slope).
   bytes += static_cast<std::size_t>(capacity_) * (static_cast<std::size_t>(config_.order + 1) + 5) * sizeof(double) +
-           static_cast<std::size_t>(capacity_ + 1) * sizeof(Vec3) + 3 * 4 * static_cast<std::size_t>(capacity_) * sizeof(double);
+           static_cast<std::size_t>(capacity_ + 1) * sizeof(Vec3) + 3 * 5 * static_cast<std::size_t>(capacity_) * sizeof(double);
   for (const auto* set : {&factors_r_, &factors_t_}) {
     bytes += set->capacity() * sizeof(BandedCholesky);
     for (const BandedCholesky& f : *set) bytes += static_cast<std::size_t>(f.size() * (f.bandwidth() + 1)) * sizeof(double);
@@ -1254,6 +1270,7 @@ bool FairingWindow::hold_outliers(const Sample& s, double step, Quat& z, Vec3& p
   const bool linear = config_.solver == WindowSolver::Linear;
   z = so3::aligned_to(s.orientation, z_[last]);
   Vec3 increment = so3::log(z_[last].conjugate() * z);
+  known_increment_ = {z_[last], z, increment};
   const Verdict rotation = rot_guard_.check(step, increment);
   if (rotation == Verdict::Hold) z = (z_[last] * so3::exp(increment)).normalized();
   if (rotation == Verdict::Release) {
@@ -1286,6 +1303,12 @@ bool FairingWindow::hold_outliers(const Sample& s, double step, Quat& z, Vec3& p
   }
   held = (rotation == Verdict::Hold ? kHeldRotation : 0) | (position == Verdict::Hold ? kHeldPosition : 0);
   return held != 0;
+}
+
+Vec3 FairingWindow::increment_log(const Quat& from, const Quat& to) const {
+  const KnownIncrement& known = known_increment_;
+  if (known.from.coeffs() == from.coeffs() && known.to.coeffs() == to.coeffs()) return known.log;
+  return so3::log(from.conjugate() * to);
 }
 
 // Whether the window stands in for samples lost now: where each of its samples is one interval,
@@ -1383,7 +1406,7 @@ void FairingWindow::append(const Sample& s) {
   }
   z_[k] = z;
   if (config_.solver == WindowSolver::Linear) {
-    if (n_ >= 1) zeta_[k - 1] = so3::log(z_[k - 1].conjugate() * z);
+    if (n_ >= 1) zeta_[k - 1] = increment_log(z_[k - 1], z);
     if (positions_) {
       zp_[k] = s.position;
       if (n_ >= 1) dzp_[k - 1] = s.position - zp_[k - 1];

@@ -205,6 +205,13 @@ class FairingWindow {
     double mu = 0.0;            // fixed μ, or the adapted one
     double level = 0.0;         // adapted: real index into levels_
     EmissionRow fixed;          // fixed μ: the full window's row
+    // Adapted, between two levels: their rows' weights on ζ blended for the level in use, kept
+    // while it stays (at 1 kHz the level is chosen every fourth sample); level −1: none yet.
+    struct Blend {
+      std::vector<double> zeta;
+      int first = 0;
+      double level = -1.0;
+    } blend;
     MotionNoiseEstimator estimator;
     // At rest (adapted): the line through the samples since the rest began (in
     // rest_coordinate, from the rest's first pose R or position p_0), the time of the last
@@ -337,6 +344,14 @@ class FairingWindow {
   // yet extrapolates the step from it (predict_from_last_step).
   Quat last_z_ = Quat::Identity();
   Vec3 last_p_ = Vec3::Zero();
+  // The newest increment the outlier guard took, log(from⁻¹to), with its two ends: append() takes
+  // it where its sample's ends are the same, instead of the same logarithm again.
+  struct KnownIncrement {
+    Quat from = Quat::Identity(), to = Quat::Identity();
+    Vec3 log = Vec3::Zero();
+  };
+  KnownIncrement known_increment_;
+  Vec3 increment_log(const Quat& from, const Quat& to) const;
   bool last_has_position_ = false;
   // A stream that repeats its measurements: what tells it, and the last two poses the window
   // emitted (lag 0) with their samples' times, which a repeat carries forward.
