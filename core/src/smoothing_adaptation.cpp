@@ -166,17 +166,18 @@ void MotionNoiseEstimator::update_median(Estimates::LengthMedian& m, double leng
     m.first_lengths[static_cast<std::size_t>(m.count++)] = length;
     std::array<double, 15> sorted = m.first_lengths;
     m.log_median = std::log(upper_median(std::span(sorted).first(static_cast<std::size_t>(m.count))));
+    m.median = std::exp(m.log_median);
   } else {
     // Stochastic approximation of the median in log space: a step up when above, down when
     // below; its time constant is about 1/(2·step) samples. A long run on one side, or a short one
     // far from it, is a noise that changed its level: the step doubles with each length beyond
-    // (kNoiseRunSamples, kNoiseFarSamples).
-    const double from_median = std::log(length) - m.log_median;
-    const bool above = from_median > 0.0;
+    // (kNoiseRunSamples, kNoiseFarSamples). Each length is compared with the median itself, kept
+    // beside its log (a logarithm per sample less).
+    const bool above = length > m.median;
     m.run = above ? std::max(m.run, 0) + 1 : std::min(m.run, 0) - 1;
-    const double far = std::log(kNoiseFarFactor);
-    m.far_run = from_median > far ? std::max(m.far_run, 0) + 1 : from_median < -far ? std::min(m.far_run, 0) - 1 : 0;
-    m.recent_far = (m.recent_far << 1) | (from_median > far ? 1u : 0u);
+    const bool far_above = length > kNoiseFarFactor * m.median, far_below = kNoiseFarFactor * length < m.median;
+    m.far_run = far_above ? std::max(m.far_run, 0) + 1 : far_below ? std::min(m.far_run, 0) - 1 : 0;
+    m.recent_far = (m.recent_far << 1) | (far_above ? 1u : 0u);
     m.recent_square += kRecentNoiseWeight * (length * length - m.recent_square);
     m.recent_above = (m.recent_above << 1) | (above ? 1u : 0u);
     // Risen where most of the newest lengths stand far above the median, and while most stand
@@ -188,6 +189,7 @@ void MotionNoiseEstimator::update_median(Estimates::LengthMedian& m, double leng
     const int beyond = std::max(std::abs(m.run) - kNoiseRunSamples, std::abs(m.far_run) - kNoiseFarSamples);
     if (beyond > 0) step = std::max(step, std::min(kNoiseRunStepCap, std::ldexp(step, std::min(beyond, 60))));
     m.log_median += above ? step : -step;
+    m.median = std::exp(m.log_median);
   }
 }
 
@@ -252,11 +254,11 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
   if (n1 >= low_.order) {
     // D^kθ spans k + 1 samples: one that reaches a stand-in measures its interpolation, not the noise.
     if (measured > low_.order) update_median(e_.low, newest_difference(zeta, low_).norm(), dt);
-    double s = std::exp(e_.low.log_median) * low_.sigma_per_median;
+    double s = e_.low.median * low_.sigma_per_median;
     if (high_.order > 0 && n1 >= high_.order) {
       if (measured > high_.order) update_median(e_.high, newest_difference(zeta, high_).norm(), dt);
       // Once its exact start is complete: a median of a few values is not yet the noise's.
-      if (e_.high.settled()) s = std::min(s, kNoiseOrderMargin * std::exp(e_.high.log_median) * high_.sigma_per_median);
+      if (e_.high.settled()) s = std::min(s, kNoiseOrderMargin * e_.high.median * high_.sigma_per_median);
     }
     if (e_.low.count > 0) e_.noise_var = s * s;  // (none yet where only stand-ins' differences came)
   }

@@ -247,6 +247,7 @@ class MotionNoiseEstimator {
       std::array<double, 15> first_lengths{};
       int count = 0;
       double log_median = 0.0;
+      double median = 1.0;  // exp(log_median), kept with it: the lengths are compared with it
       int run = 0;  // lengths in a row above the median (> 0) or below it (< 0)
       int far_run = 0;  // lengths in a row kNoiseFarFactor times above it (> 0) or below (< 0)
       std::uint32_t recent_far = 0;    // bit i: the (i + 1)-th newest length stood kNoiseFarFactor times above it
