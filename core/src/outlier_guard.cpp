@@ -55,21 +55,24 @@ OutlierGuard::Verdict OutlierGuard::check(double step, Vec3& increment) {
       const Vec3 at_zero = (sy - slope * su) / points;
       const Vec3 predicted = at_zero + slope * step;
       const double distance = (increment - predicted).norm() / scale_;
-      const double median = std::exp(log_median_);
+      const double median = median_;
       const bool warm = seen_ >= kOutlierWarmUp;
       const bool held_now = warm && distance > kOutlierFloor && distance > threshold_ * median &&
                             ((ordinary_before_ && settled) || (held_before && held_run < kMaxHeldRun));
       ordinary_before_ = warm && distance <= kOrdinary * median;
-      const double log_distance = std::log(std::max(distance, 1e-300));
+      // The median is tracked in logs and compared as itself (a logarithm only while warming up).
       if (increment.isZero(0.0)) {
         // The same measurement again (a tracker that repeats its last value while it sees
         // nothing): not a new one, and the line soon predicts it exactly, so learning from it would
         // bring the median down towards nothing and, once the stream moves again, hold its noise.
       } else if (warm) {
-        log_median_ += kRate * (log_distance > log_median_ ? 1.0 : -1.0);
+        log_median_ += kRate * (distance > median ? 1.0 : -1.0);
+        median_ = std::exp(log_median_);
       } else {
         // Counted only up to the warm-up: a daemon's stream outlives an int's count of samples.
+        const double log_distance = std::log(std::max(distance, 1e-300));
         log_median_ = seen_ == 0 ? log_distance : std::max(log_median_, log_distance);
+        median_ = std::exp(log_median_);
         ++seen_;
       }
       // Where the held sample was real, this one goes on from it as the line goes on: the line's

@@ -86,6 +86,7 @@ class OutlierGuard {
   int head_ = 0;
   int count_ = 0;
   double log_median_ = 0.0;
+  double median_ = 1.0;  // exp(log_median_)
   int seen_ = 0;  // distances seen, up to kOutlierWarmUp
   bool ordinary_before_ = false;  // the sample before landed within kOrdinary times the median
   Vec3 held_offset_ = Vec3::Zero();  // the newest held sample's measurement from the prediction
