@@ -344,6 +344,7 @@ class FairingWindow {
   // yet extrapolates the step from it (predict_from_last_step).
   Quat last_z_ = Quat::Identity();
   Vec3 last_p_ = Vec3::Zero();
+  bool last_has_position_ = false;
   // The newest increment the outlier guard took, log(from⁻¹to), with its two ends: append() takes
   // it where its sample's ends are the same, instead of the same logarithm again.
   struct KnownIncrement {
@@ -352,7 +353,6 @@ class FairingWindow {
   };
   KnownIncrement known_increment_;
   Vec3 increment_log(const Quat& from, const Quat& to) const;
-  bool last_has_position_ = false;
   // A stream that repeats its measurements: what tells it, and the last two poses the window
   // emitted (lag 0) with their samples' times, which a repeat carries forward.
   RepeatedMeasurements repeats_;
