@@ -197,12 +197,21 @@ double MotionNoiseEstimator::recent_noise_var() const {
   // Not where the newest lengths reach past the motion fit's span (under 30 Hz with the
   // defaults): there a quick turn lasts a few samples and fills most of them.
   if (kRecentNoiseSamples > span_ + 1) return 0.0;
-  auto recent = [](const Estimates::LengthMedian& m, const NoiseDifference& d) {
-    return m.settled() && m.risen ? m.recent_square * d.var_per_square : 0.0;
+  // Each order's σ² now: its newest lengths' where it reads the noise as risen. Or its median's,
+  // where that has caught up with a noise that rose: one order's median may while the other's
+  // lags (the tracked σ, the smaller of the two, is then still the old noise's), and the order
+  // that caught up no longer reads the noise as risen; its median stands kCaughtUpFactor over
+  // the tracked σ² (white noise keeps both orders' medians within a few per cent of each other).
+  auto now = [&](const Estimates::LengthMedian& m, const NoiseDifference& d) {
+    if (!m.settled()) return 0.0;
+    if (m.risen) return m.recent_square * d.var_per_square;
+    const double median_var = std::pow(m.median * d.sigma_per_median, 2);
+    return median_var > kCaughtUpFactor * e_.noise_var ? median_var : 0.0;
   };
-  double v = recent(e_.low, low_);
+  if (!(e_.low.risen || (high_.order > 0 && e_.high.risen))) return 0.0;
+  double v = now(e_.low, low_);
   // Both orders, as the tracked σ: a motion at a third of the rate fills the lower one.
-  if (v > 0.0 && high_.order > 0) v = std::min(v, kNoiseOrderMargin * kNoiseOrderMargin * recent(e_.high, high_));
+  if (high_.order > 0) v = std::min(v, kNoiseOrderMargin * kNoiseOrderMargin * now(e_.high, high_));
   return v;
 }
 

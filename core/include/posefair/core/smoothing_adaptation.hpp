@@ -234,6 +234,9 @@ class MotionNoiseEstimator {
   // go out at the still pose until each sample stood beyond it (docs/engine.md, "A noise burst
   // at rest").
   static constexpr int kRecentNoiseSamples = 9;
+  // An order's median has caught up with a noise that rose where it stands this many times over
+  // the tracked σ² (recent_noise_var).
+  static constexpr double kCaughtUpFactor = 2.0;
   static_assert(kRecentNoiseSamples < 32, "the newest lengths are bits of a std::uint32_t");
   static constexpr double kRecentNoiseWeight = 0.2;
 
