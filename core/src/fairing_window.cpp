@@ -19,6 +19,10 @@ namespace {
 // How far a measured rate may be left (as a ratio, either way) before the window follows.
 constexpr double kRateChange = 1.5;
 
+// A step between the last two poses whose square is this many times their noise's is motion,
+// carried on whole to a repeat (carried_share); within it, by its Wiener weight.
+constexpr double kClearStep = 9.0;
+
 // Moves x onto the ball of radius eps around z (distance on S³ for rotations) if it is outside,
 // and checks the result with the same distance the promise is stated in: the radius is shrunk
 // step by step until rounding can no longer carry the result past eps (an absolute rounding of
@@ -976,6 +980,23 @@ int FairingWindow::start_afresh(std::span<FairedPose> out) {
   return count;
 }
 
+// How much of a step Δ between the window's last two poses to carry on to a repeat: one more
+// than three times their noise's standard deviation is motion, carried whole; within that, the
+// Wiener weight |Δ|²/(|Δ|² + E|n|²), n the two poses' noise (per component σ² times the level's
+// noise gain, each; their correlation left out, so E|n|² errs high). Carrying a step of noise on
+// adds it again: a still stream faired from few measurements had 1.4 times its measurements'
+// error on its repeats. Before the rate is known the poses are measurements, and a motion's
+// steps are carried as before (holding costs a moving stream more than carrying noise costs a
+// still one); a fixed μ carries its steps too.
+double FairingWindow::carried_share(const Channel& ch, const Vec3& step) const {
+  if (!ch.adaptive || !prepared_) return 1.0;
+  const LevelRows r = level_rows(ch);
+  const double noise = 2.0 * 3.0 * ch.estimator.noise_variance() * ((1.0 - r.f) * r.a.noise_gain + r.f * r.b.noise_gain);
+  const double d2 = step.squaredNorm();
+  if (d2 > kClearStep * noise) return 1.0;
+  return d2 > 0.0 ? d2 / (d2 + noise) : 0.0;
+}
+
 // The motion of the window's last two poses, carried on to the repeat's time, for at most one
 // interval of the source (a repeat later than that is a source that stalled: held, not
 // extrapolated); a slerped sample before the newest pose's time, interpolated between the two.
@@ -988,8 +1009,12 @@ FairedPose FairingWindow::carry_forward(const Sample& s) {
   Vec3 p = measured ? s.position : w.position[1];
   if (w.count >= 2 && w.time[1] > w.time[0]) {
     const double ahead = std::max(std::min(s.time - w.time[1], typical_interval()) / (w.time[1] - w.time[0]), -1.0);
-    q = (q * so3::exp(ahead * so3::log(w.orientation[0].conjugate() * q))).normalized();
-    p += ahead * (p - w.position[0]);
+    const Vec3 turn = so3::log(w.orientation[0].conjugate() * q);
+    const Vec3 move = p - w.position[0];
+    // Ahead, each channel's step only as far as it stands clear of the poses' noise; between
+    // the two poses (a slerped sample) it is interpolated.
+    q = (q * so3::exp(ahead * (ahead > 0.0 ? carried_share(rot_, turn) : 1.0) * turn)).normalized();
+    p += ahead * (ahead > 0.0 && positions_ ? carried_share(pos_, move) : 1.0) * move;
   }
   bool clamped = project_rotation(so3::aligned_to(s.orientation, q), q, config_.epsilon_r);
   if (have_emitted_) q = so3::aligned_to(q, last_emitted_);

@@ -314,6 +314,7 @@ class FairingWindow {
   int fair(const Sample& sample, std::span<FairedPose> out);
   int interpolate_slerped(const Sample& sample, const SlerpKnot* next, std::span<FairedPose> out);
   FairedPose carry_forward(const Sample& s);
+  double carried_share(const Channel& ch, const Vec3& step) const;
   void note_window_pose(FairedPose& pose, double time);
   void check_continuity_stability() const;
   void solve();
