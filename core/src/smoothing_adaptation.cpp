@@ -179,6 +179,7 @@ void MotionNoiseEstimator::update_median(Estimates::LengthMedian& m, double leng
     m.far_run = far_above ? std::max(m.far_run, 0) + 1 : far_below ? std::min(m.far_run, 0) - 1 : 0;
     m.recent_far = (m.recent_far << 1) | (far_above ? 1u : 0u);
     m.recent_square += kRecentNoiseWeight * (length * length - m.recent_square);
+    m.steady_square += kSteadyNoiseWeight * (length * length - m.steady_square);
     m.recent_above = (m.recent_above << 1) | (above ? 1u : 0u);
     // Risen where most of the newest lengths stand far above the median, and while most stand
     // above it: the median catching up on a burst (within a second) is not the burst's end.
@@ -204,7 +205,7 @@ double MotionNoiseEstimator::recent_noise_var() const {
   // the tracked σ² (white noise keeps both orders' medians within a few per cent of each other).
   auto now = [&](const Estimates::LengthMedian& m, const NoiseDifference& d) {
     if (!m.settled()) return 0.0;
-    if (m.risen) return m.recent_square * d.var_per_square;
+    if (m.risen) return std::max(m.recent_square, m.steady_square) * d.var_per_square;
     const double median_var = std::pow(m.median * d.sigma_per_median, 2);
     return median_var > kCaughtUpFactor * e_.noise_var ? median_var : 0.0;
   };

@@ -1250,21 +1250,16 @@ TEST(Adaptation, ANoiseBurstAtRestIsNoMotion) {
   }
 }
 
-TEST(Adaptation, ABurstStaysNoiseWhileOneOrderHasCaughtUpWithIt) {
-  // Bursts of noise (five times, for a second every five) on a still tracker at 250 Hz: one
-  // order's median caught up with a burst within a fifth of a second and no longer read the noise
-  // as risen while the other's lagged, and the rest was judged against the old noise again: the
-  // rest of the burst was smoothed at a few Hz. Now the order that caught up stands for the burst
-  // by its median (MotionNoiseEstimator::kCaughtUpFactor). Error against raw's over the bursts
-  // after their first 0.1 s, 3 seeds: 0.140 before, 0.106 now (`posefair bench streams`' still
-  // stream with bursts at 250 Hz: 23% less error).
+// Bursts of noise (five times, for a second every five) on a still tracker of noise 0.002 rad
+// per axis, 25 s, 3 seeds: the defaults' error against raw's over the bursts from `after`
+// seconds into each.
+double error_over_bursts(double rate, double after) {
   double error = 0.0, raw = 0.0;
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     std::mt19937_64 rng(seed);
     std::normal_distribution<double> noise(0.0, 0.002);
     Stream s;
-    const double rate = 250.0;
-    auto bursting = [](double t, double after) { return std::fmod(t, 5.0) >= 3.0 + after && std::fmod(t, 5.0) < 4.0; };
+    auto bursting = [](double t, double from) { return std::fmod(t, 5.0) >= 3.0 + from && std::fmod(t, 5.0) < 4.0; };
     for (int i = 0; i < static_cast<int>(25.0 * rate); ++i) {
       const double t = i / rate;
       s.input.time.push_back(t);
@@ -1272,12 +1267,35 @@ TEST(Adaptation, ABurstStaysNoiseWhileOneOrderHasCaughtUpWithIt) {
       s.input.orientation.push_back(so3::from_rotation_vector((bursting(t, 0.0) ? 5.0 : 1.0) * Vec3(noise(rng), noise(rng), noise(rng))));
     }
     each_default_pose(s, [&](std::size_t i, const FairedPose& p, const FairingWindow&) {
-      if (!bursting(s.input.time[i], 0.1)) return;
+      if (!bursting(s.input.time[i], after)) return;
       error += std::pow(so3::dist(p.orientation, s.truth[i]), 2);
       raw += std::pow(so3::dist(s.input.orientation[i], s.truth[i]), 2);
     });
   }
-  EXPECT_LT(std::sqrt(error / raw), 0.12);
+  return std::sqrt(error / raw);
+}
+
+TEST(Adaptation, ABurstStaysNoiseWhileOneOrderHasCaughtUpWithIt) {
+  // Bursts of noise (five times, for a second every five) on a still tracker at 250 Hz: one
+  // order's median caught up with a burst within a fifth of a second and no longer read the noise
+  // as risen while the other's lagged, and the rest was judged against the old noise again: the
+  // rest of the burst was smoothed at a few Hz. Now the order that caught up stands for the burst
+  // by its median (MotionNoiseEstimator::kCaughtUpFactor). Error against raw's over the bursts
+  // after their first 0.1 s, 3 seeds: 0.140 before, 0.106 after (0.105 with the slower mean of
+  // the test below; `posefair bench streams`' still
+  // stream with bursts at 250 Hz: 23% less error).
+  EXPECT_LT(error_over_bursts(250.0, 0.1), 0.12);
+}
+
+TEST(Adaptation, ABurstsLevelHoldsWhileItsNewestLengthsDip) {
+  // Bursts of noise (five times, for a second every five) on a still tracker at 60 Hz: the
+  // newest lengths' mean square, which a rest is judged against while the noise has risen, dipped
+  // by chance within a burst, and the rest was left for a few samples each time. Now the larger of
+  // it and a slower mean (MotionNoiseEstimator::kSteadyNoiseWeight) holds the burst's level.
+  // Error against raw's over the bursts after their first 0.2 s, 3 seeds: 0.175 before, 0.164 now,
+  // samples there not averaged at rest 20 before, 14 now (`posefair bench streams`' still stream
+  // with bursts at 60 Hz: 12% less error; at 250 Hz 9.5%).
+  EXPECT_LT(error_over_bursts(60.0, 0.2), 0.17);
 }
 
 TEST(Adaptation, AnOutlierAtRestIsNotTakenForAMotion) {

@@ -239,6 +239,13 @@ class MotionNoiseEstimator {
   static constexpr double kCaughtUpFactor = 2.0;
   static_assert(kRecentNoiseSamples < 32, "the newest lengths are bits of a std::uint32_t");
   static constexpr double kRecentNoiseWeight = 0.2;
+  // The newest lengths' mean square follows a burst's onset within a few samples, but as quickly
+  // dips by chance within it (to a third of the burst's level, on the high orders' correlated
+  // lengths), and the rest judged against that dip was left: a still stream with bursts at 60 Hz
+  // was smoothed at a few Hz for a fraction of each burst. While the noise has risen, an order's
+  // σ² is the larger of that mean and a slower one's (weight kSteadyNoiseWeight, about 20 lengths),
+  // which holds the burst's level.
+  static constexpr double kSteadyNoiseWeight = 0.05;
 
   // What the estimator has learnt from the stream (its weights aside, which configure() sets):
   // small and copyable, so that a window can put it back as it was before a sample it took
@@ -256,6 +263,7 @@ class MotionNoiseEstimator {
       std::uint32_t recent_far = 0;    // bit i: the (i + 1)-th newest length stood kNoiseFarFactor times above it
       std::uint32_t recent_above = 0;  // bit i: ... stood above it
       double recent_square = 0.0;      // the lengths' squares, a running mean (kRecentNoiseWeight)
+      double steady_square = 0.0;      // the same, a slower running mean (kSteadyNoiseWeight)
       bool risen = false;              // the noise has risen lately (kRecentNoiseSamples)
       bool settled() const { return count >= static_cast<int>(first_lengths.size()); }
     };
