@@ -507,8 +507,7 @@ FairingWindow::LevelRows FairingWindow::level_rows(const Channel& ch) const {
 }
 
 double FairingWindow::correction_gain(const Channel& ch) const {
-  const LevelRows r = level_rows(ch);
-  return (1.0 - r.f) * r.a.correction_gain + r.f * r.b.correction_gain;
+  return level_rows(ch).blended(&EmissionRow::correction_gain);
 }
 
 // What the level in use corrected at the emitted sample k, for the motion estimate
@@ -527,7 +526,7 @@ void FairingWindow::note_correction(Channel& ch, int k, const Vec3& u, double dt
     return;
   }
   const LevelRows r = level_rows(ch);
-  ch.estimator.note_correction(u.squaredNorm() / 3.0, correction_gain(ch), (1.0 - r.f) * r.a.bias + r.f * r.b.bias, dt);
+  ch.estimator.note_correction(u.squaredNorm() / 3.0, r.blended(&EmissionRow::correction_gain), r.blended(&EmissionRow::bias), dt);
 }
 
 Vec3 FairingWindow::linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c) {
@@ -990,8 +989,7 @@ int FairingWindow::start_afresh(std::span<FairedPose> out) {
 // still one); a fixed μ carries its steps too.
 double FairingWindow::carried_share(const Channel& ch, const Vec3& step) const {
   if (!ch.adaptive || !prepared_) return 1.0;
-  const LevelRows r = level_rows(ch);
-  const double noise = 2.0 * 3.0 * ch.estimator.noise_variance() * ((1.0 - r.f) * r.a.noise_gain + r.f * r.b.noise_gain);
+  const double noise = 2.0 * 3.0 * ch.estimator.noise_variance() * level_rows(ch).blended(&EmissionRow::noise_gain);
   const double d2 = step.squaredNorm();
   if (d2 > kClearStep * noise) return 1.0;
   return d2 > 0.0 ? d2 / (d2 + noise) : 0.0;

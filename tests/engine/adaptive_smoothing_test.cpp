@@ -1281,9 +1281,8 @@ TEST(Adaptation, ABurstStaysNoiseWhileOneOrderHasCaughtUpWithIt) {
   // as risen while the other's lagged, and the rest was judged against the old noise again: the
   // rest of the burst was smoothed at a few Hz. Now the order that caught up stands for the burst
   // by its median (MotionNoiseEstimator::kCaughtUpFactor). Error against raw's over the bursts
-  // after their first 0.1 s, 3 seeds: 0.140 before, 0.106 after (0.105 with the slower mean of
-  // the test below; `posefair bench streams`' still
-  // stream with bursts at 250 Hz: 23% less error).
+  // after their first 0.1 s, 3 seeds: 0.140 before, 0.106 after (`posefair bench streams`' still
+  // stream with bursts at 250 Hz: 23% less error); 0.105 with the slower mean of the test below.
   EXPECT_LT(error_over_bursts(250.0, 0.1), 0.12);
 }
 

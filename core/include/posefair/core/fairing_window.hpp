@@ -300,6 +300,8 @@ class FairingWindow {
     const EmissionRow& a;
     const EmissionRow& b;
     double f;
+    // One of the rows' error figures (noise_gain, bias, correction_gain) for the blend.
+    double blended(double EmissionRow::*figure) const { return (1.0 - f) * a.*figure + f * b.*figure; }
   };
   LevelRows level_rows(const Channel& ch) const;
   double correction_gain(const Channel& ch) const;  // of the level in use
