@@ -519,7 +519,7 @@ double FairingWindow::correction_gain(const Channel& ch) const {
 void FairingWindow::note_correction(Channel& ch, int k, const Vec3& u, double dt) {
   if (!ch.adaptive || !prepared_ || (&ch == &rot_ && aided_)) return;
   const char bit = &ch == &rot_ ? kHeldRotation : kHeldPosition;
-  const bool learn = n_ == w_ && config_.horizon_s == 0.0 && !ch.estimator.at_rest() && ch.level > 0.0 &&
+  const bool learn = n_ == w_ && config_.horizon_s == 0.0 && !ch.estimator.at_rest() && !ch.rest.resting && ch.level > 0.0 &&
                      !((held_[static_cast<std::size_t>(k)] | newest_held_) & bit);
   if (!learn) {
     ch.estimator.note_correction(0.0, 0.0, 0.0, dt);
@@ -636,6 +636,14 @@ void FairingWindow::linear_emission_estimate(int k, double dt) {
       note_correction(ch, k, Vec3::Zero(), dt);
       return Vec3::Zero();
     }
+    if (ch.rest.resting && ch.rest.leaving == 0) {
+      // At rest nothing is learned from the correction (note_correction), and once the rest line's
+      // weight is whole the window's correction has no part in the output: it is not computed (a
+      // row over the whole window, the largest part of the engine's cost at rest).
+      note_correction(ch, k, Vec3::Zero(), dt);
+      const RestPart rest = rest_part(ch, k, dt);
+      return rest.weight == 1.0 ? rest.pose : rest.over(linear_correction(ch, zeta, c));
+    }
     const Vec3 u = linear_correction(ch, zeta, c);
     note_correction(ch, k, u, dt);
     // The motion estimate takes a motion out of rest from its fits, which see its start dimly for
@@ -651,7 +659,7 @@ void FairingWindow::linear_emission_estimate(int k, double dt) {
         return Vec3::Zero();
       ch.rest.leaving = 0;
     }
-    return rest_blend(ch, k, u, dt);
+    return rest_part(ch, k, dt).over(u);
   };
   est_[i] = correction(rot_, rotation_increments(), c_, rot_departs);
   if (positions_) xp_[i] = zp_[i] + correction(pos_, dzp_, cp_, pos_departs);
@@ -669,7 +677,7 @@ std::span<const Vec3> FairingWindow::rest_increments(int count) {
     return {};
   }
   const Quat& r = rot_.rest.reference;
-  auto coordinate = [&](int j) { return so3::log(r.conjugate() * z_[static_cast<std::size_t>(j)]); };
+  auto coordinate = [&](int j) { return rest_coordinate(rot_, j); };
   const bool fresh = !rest_chart_ready_ || rest_chart_reference_.coeffs() != r.coeffs();
   const int from = fresh ? 0 : count - 1;
   Vec3 before = coordinate(from);
@@ -760,7 +768,15 @@ std::optional<Vec3> FairingWindow::from_rest_line(const Channel& ch) const {
 // Adaptation.AStillPoseUnderHeavyNoiseIsAveragedToo).
 Vec3 FairingWindow::rest_coordinate(const Channel& ch, int j) const {
   const auto i = static_cast<std::size_t>(j);
-  return &ch == &rot_ ? so3::log(ch.rest.reference.conjugate() * z_[i]) : Vec3(zp_[i] - ch.rest.origin);
+  if (&ch != &rot_) return zp_[i] - ch.rest.origin;
+  const Eigen::Vector4d& r = ch.rest.reference.coeffs();
+  const Eigen::Vector4d& z = z_[i].coeffs();
+  for (const RestChartMemo& m : rest_chart_memo_)
+    if (m.z == z && m.reference == r) return m.coordinate;
+  RestChartMemo& m = rest_chart_memo_[rest_chart_memo_next_];
+  rest_chart_memo_next_ = (rest_chart_memo_next_ + 1) % rest_chart_memo_.size();
+  m = {r, z, so3::log(ch.rest.reference.conjugate() * z_[i])};
+  return m.coordinate;
 }
 
 // At rest, the channel's samples also feed a line with a memory of seconds (rest_line.hpp),
@@ -828,8 +844,9 @@ void FairingWindow::follow_rest(Channel& ch, bool departs) {
 // Sample k's correction (in its chart, as linear_correction's): the window's, moved toward the
 // rest line's while the line is straight, and back while it is not, over motion_time_s (a
 // switch would step the output, and a stream at the edge of rest switches often). A motion
-// seen at rest takes the window's at once, as leaving rest does.
-Vec3 FairingWindow::rest_blend(Channel& ch, int k, const Vec3& window, double dt) {
+// seen at rest takes the window's at once, as leaving rest does. Here the line's weight is
+// followed and its pose taken; RestPart::over puts it over the window's.
+FairingWindow::RestPart FairingWindow::rest_part(Channel& ch, int k, double dt) {
   ch.rest.averaged = false;
   // The line's ages count from the last sample it took (the newest, unless that one was off it).
   const double age = ch.rest.time - samples_[static_cast<std::size_t>(k)].time - config_.horizon_s;
@@ -839,18 +856,21 @@ Vec3 FairingWindow::rest_blend(Channel& ch, int k, const Vec3& window, double dt
           : std::nullopt;
   if (!value) {
     ch.rest.weight = 0.0;
-    return window;
+    return {};
   }
   ch.rest.averaged = value->straight;
   const double target = value->straight ? 1.0 : 0.0;
   ch.rest.weight += (target - ch.rest.weight) * (1.0 - std::exp(-std::max(dt, 0.0) / config_.adaptation.motion_time_s));
-  if (!(ch.rest.weight > 0.0)) return window;
+  // Within kWholeRest of whole it is whole (after 6.9 motion_time_s of a straight line): the
+  // window's part would move the pose by that share of its distance from the line's pose, a few
+  // thousandths of the noise, and then need not be computed (RestPart).
+  if (target == 1.0 && 1.0 - ch.rest.weight < kWholeRest) ch.rest.weight = 1.0;
+  if (!(ch.rest.weight > 0.0)) return {};
   if (&ch == &rot_) {  // the still pose, R·exp(pose), in sample k's chart
     const auto i = static_cast<std::size_t>(k);
-    const Vec3 still = so3::log(z_[i].conjugate() * (ch.rest.reference * so3::exp(value->pose)));
-    return window + ch.rest.weight * (still - window);
+    return {ch.rest.weight, so3::log(z_[i].conjugate() * (ch.rest.reference * so3::exp(value->pose)))};
   }
-  return window + ch.rest.weight * (value->pose - rest_coordinate(ch, k) - window);
+  return {ch.rest.weight, value->pose - rest_coordinate(ch, k)};
 }
 
 // Constant angular (and linear) velocity from the last accepted measurement to the newest,

@@ -308,7 +308,14 @@ class FairingWindow {
   Vec3 linear_correction(Channel& ch, std::span<const Vec3> zeta, std::span<const Vec3> c);
   bool fill_moves(const Channel& ch, std::span<const Vec3> zeta);
   void follow_rest(Channel& ch, bool departs);
-  Vec3 rest_blend(Channel& ch, int k, const Vec3& window, double dt);
+  // The rest line's part in sample k's correction: its weight and its pose (weight 0: none).
+  struct RestPart {
+    double weight = 0.0;
+    Vec3 pose = Vec3::Zero();
+    Vec3 over(const Vec3& window) const { return weight > 0.0 ? (window + weight * (pose - window)).eval() : window; }
+  };
+  static constexpr double kWholeRest = 1e-3;
+  RestPart rest_part(Channel& ch, int k, double dt);
   void linear_emission_estimate(int k, double dt);
   void predict_from_last_step(int k, double step);
   bool carries_repeats() const;
@@ -422,6 +429,15 @@ class FairingWindow {
   SlidingArray<Vec3> rest_zeta_;
   Quat rest_chart_reference_ = Quat::Identity();
   bool rest_chart_ready_ = false;
+  // The newest rotations' rest coordinates, log(R⁻¹z): at rest the newest sample's is wanted by the
+  // departure test, the rest test's increments and the line, and the one before it by the
+  // increments again (one log per sample instead of four). Keyed by R and z themselves.
+  struct RestChartMemo {
+    Eigen::Vector4d reference = Eigen::Vector4d::Zero(), z = Eigen::Vector4d::Zero();  // (no unit quaternion)
+    Vec3 coordinate = Vec3::Zero();
+  };
+  mutable std::array<RestChartMemo, 2> rest_chart_memo_{};
+  mutable std::size_t rest_chart_memo_next_ = 0;
   SlidingArray<Vec3> est_;         // e_i: estimate x_i = z_i exp(e_i) (Linear)
   SlidingArray<Vec3> c_;           // log(z_i⁻¹ y_i) of emitted samples (Linear)
   SlidingArray<Vec3> dzp_;         // p_{j+1} − p_j (Linear)
