@@ -860,7 +860,8 @@ FairingWindow::RestPart FairingWindow::rest_part(Channel& ch, int k, double dt) 
   }
   ch.rest.averaged = value->straight;
   const double target = value->straight ? 1.0 : 0.0;
-  ch.rest.weight += (target - ch.rest.weight) * (1.0 - std::exp(-std::max(dt, 0.0) / config_.adaptation.motion_time_s));
+  if (ch.rest.weight != target)
+    ch.rest.weight += (target - ch.rest.weight) * (1.0 - std::exp(-std::max(dt, 0.0) / config_.adaptation.motion_time_s));
   // Within kWholeRest of whole it is whole (after 6.9 motion_time_s of a straight line): the
   // window's part would move the pose by that share of its distance from the line's pose, a few
   // thousandths of the noise, and then need not be computed (RestPart).
