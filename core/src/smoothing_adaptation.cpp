@@ -203,11 +203,17 @@ double MotionNoiseEstimator::recent_noise_var() const {
   // lags (the tracked σ, the smaller of the two, is then still the old noise's), and the order
   // that caught up no longer reads the noise as risen; its median stands kCaughtUpFactor over
   // the tracked σ² (white noise keeps both orders' medians within a few per cent of each other).
+  // Or, where it does neither, its slower mean square's (kSteadyNoiseWeight), where that stands as
+  // far over: within a burst an order's risen state drops by chance while its median still lags
+  // (the higher order's, at 250 Hz), and the smaller of the two then read no rise. Not after a
+  // motion stopped: the slower mean still holds the motion's end (a quick turn's, at 30 Hz).
   auto now = [&](const Estimates::LengthMedian& m, const NoiseDifference& d) {
     if (!m.settled()) return 0.0;
     if (m.risen) return std::max(m.recent_square, m.steady_square) * d.var_per_square;
     const double median_var = std::pow(m.median * d.sigma_per_median, 2);
-    return median_var > kCaughtUpFactor * e_.noise_var ? median_var : 0.0;
+    if (median_var > kCaughtUpFactor * e_.noise_var) return median_var;
+    const double steady_var = m.steady_square * d.var_per_square;
+    return e_.stopped_motion == 0.0 && steady_var > kCaughtUpFactor * e_.noise_var ? steady_var : 0.0;
   };
   if (!(e_.low.risen || (high_.order > 0 && e_.high.risen))) return 0.0;
   double v = now(e_.low, low_);
