@@ -314,7 +314,7 @@ class FairingWindow {
     Vec3 pose = Vec3::Zero();
     Vec3 over(const Vec3& window) const { return weight > 0.0 ? (window + weight * (pose - window)).eval() : window; }
   };
-  static constexpr double kWholeRest = 1e-3;
+  static constexpr double kWholeRest = 1e-3;  // the line's weight this near whole is whole (rest_part)
   RestPart rest_part(Channel& ch, int k, double dt);
   void linear_emission_estimate(int k, double dt);
   void predict_from_last_step(int k, double step);
