@@ -4,6 +4,9 @@
 // sum every add waits for the one before (a 4-cycle latency per term), with four independent
 // sums the adds overlap. The additions are grouped differently from a plain loop, so the
 // result may differ from one in the last bits.
+// Two neighbouring 3-vectors are six contiguous doubles: three 2-wide vector operations (GCC's
+// and Clang's vector extensions, which the build's compilers are), where each 3-vector alone
+// takes a 2-wide and a scalar one and the compiler builds the weights' pairs through memory.
 #include <cstring>
 #include <span>
 
@@ -13,13 +16,6 @@ namespace posefair {
 
 template <class Weight>
 Vec3 weighted_vector_sum(int first, int end, Weight&& w, std::span<const Vec3> v) {
-  Vec3 s0 = Vec3::Zero(), s1 = Vec3::Zero(), s2 = Vec3::Zero(), s3 = Vec3::Zero();
-  int j = first;
-#if defined(__GNUC__)
-  // Two neighbouring 3-vectors are six contiguous doubles: three 2-wide vector operations, where
-  // each 3-vector alone takes a 2-wide and a scalar one (and the compiler builds the weights'
-  // pairs through memory). a holds s0 and s1 as (s0x s0y)(s0z s1x)(s1y s1z), b likewise s2 and
-  // s3: every sum adds the same terms in the same order as the plain loop below would.
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "a span of Vec3 is contiguous doubles");
   using Two = double __attribute__((vector_size(16)));
   auto load = [](const double* p) {
@@ -27,7 +23,10 @@ Vec3 weighted_vector_sum(int first, int end, Weight&& w, std::span<const Vec3> v
     std::memcpy(&t, p, sizeof t);
     return t;
   };
+  // The partial sums s0 … s3 of terms j ≡ 0 … 3 (mod 4): a holds s0 and s1 as
+  // (s0x s0y)(s0z s1x)(s1y s1z), b likewise s2 and s3.
   Two a0{}, a1{}, a2{}, b0{}, b1{}, b2{};
+  int j = first;
   for (; j + 4 <= end; j += 4) {
     const double* p = v[static_cast<std::size_t>(j)].data();
     const double w0 = w(j), w1 = w(j + 1), w2 = w(j + 2), w3 = w(j + 3);
@@ -38,21 +37,9 @@ Vec3 weighted_vector_sum(int first, int end, Weight&& w, std::span<const Vec3> v
     b1 += Two{w2, w3} * load(p + 8);
     b2 += Two{w3, w3} * load(p + 10);
   }
-  s0 = Vec3(a0[0], a0[1], a1[0]);
-  s1 = Vec3(a1[1], a2[0], a2[1]);
-  s2 = Vec3(b0[0], b0[1], b1[0]);
-  s3 = Vec3(b1[1], b2[0], b2[1]);
-#else
-  for (; j + 4 <= end; j += 4) {
-    const auto i = static_cast<std::size_t>(j);
-    s0 += w(j) * v[i];
-    s1 += w(j + 1) * v[i + 1];
-    s2 += w(j + 2) * v[i + 2];
-    s3 += w(j + 3) * v[i + 3];
-  }
-#endif
+  Vec3 s0(a0[0], a0[1], a1[0]);
   for (; j < end; ++j) s0 += w(j) * v[static_cast<std::size_t>(j)];
-  return (s0 + s1) + (s2 + s3);
+  return (s0 + Vec3(a1[1], a2[0], a2[1])) + (Vec3(b0[0], b0[1], b1[0]) + Vec3(b1[1], b2[0], b2[1]));
 }
 
 }  // namespace posefair
