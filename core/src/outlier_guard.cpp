@@ -13,6 +13,8 @@ namespace {
 // 0.15 rad off under noise of 0.005 had two in three held with it, all but two in 28 with the
 // median).
 constexpr double kRate = 0.025;
+// The median moves by these factors (an exponential per sample was among the engine's costs).
+const double kRateUp = std::exp(kRate), kRateDown = std::exp(-kRate);
 // A sample is ordinary within three times the median (Gaussian noise lands further about once
 // in 10 000 samples). At twice the median (about its 97.5th percentile) one outlier in twenty came after
 // a sample that was not ordinary and was taken; the rule's point, that a motion building up over
@@ -60,19 +62,17 @@ OutlierGuard::Verdict OutlierGuard::check(double step, Vec3& increment) {
       const bool held_now = warm && distance > kOutlierFloor && distance > threshold_ * median &&
                             ((ordinary_before_ && settled) || (held_before && held_run < kMaxHeldRun));
       ordinary_before_ = warm && distance <= kOrdinary * median;
-      // The median is tracked in logs and compared as itself (a logarithm only while warming up).
+      // The median is tracked in log space, by factors, and compared as itself.
       if (increment.isZero(0.0)) {
         // The same measurement again (a tracker that repeats its last value while it sees
         // nothing): not a new one, and the line soon predicts it exactly, so learning from it would
         // bring the median down towards nothing and, once the stream moves again, hold its noise.
       } else if (warm) {
-        log_median_ += kRate * (distance > median ? 1.0 : -1.0);
-        median_ = std::exp(log_median_);
+        median_ *= distance > median ? kRateUp : kRateDown;
       } else {
         // Counted only up to the warm-up: a daemon's stream outlives an int's count of samples.
-        const double log_distance = std::log(std::max(distance, 1e-300));
-        log_median_ = seen_ == 0 ? log_distance : std::max(log_median_, log_distance);
-        median_ = std::exp(log_median_);
+        const double d = std::max(distance, 1e-300);
+        median_ = seen_ == 0 ? d : std::max(median_, d);
         ++seen_;
       }
       // Where the held sample was real, this one goes on from it as the line goes on: the line's

@@ -5,7 +5,7 @@
 
 namespace posefair {
 
-double PredictionCheck::scale(int j) { return std::pow(kScaleStep, j); }
+
 
 void PredictionCheck::configure(double evaluations_per_second, bool lightest_first) {
   alpha_ = evaluations_per_second > 0.0 ? 1.0 - std::exp(-1.0 / (kTime * evaluations_per_second)) : 1.0;

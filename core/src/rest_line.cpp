@@ -75,7 +75,7 @@ void RestLine::add(double dt, const Vec3& y, double memory_s, double weight) {
     age_by(weights_, dt);
     age_by(squares_, dt);
     age_by(values_, dt);
-    const double decay = std::exp(-dt / memory_s);
+    const double decay = decay_(-dt / memory_s);
     for (double& s : weights_) s *= decay;
     for (double& s : squares_) s *= decay * decay;
     for (Vec3& v : values_) v *= decay;

@@ -103,11 +103,18 @@ NoiseDifference noise_difference(int k) {
 }
 
 Vec3 newest_difference(std::span<const Vec3> zeta, const NoiseDifference& d) {
-  const std::size_t base = zeta.size() - static_cast<std::size_t>(d.order);
-  Vec3 v = Vec3::Zero();
-  for (int j = 0; j < d.order; ++j) v += d.weights[static_cast<std::size_t>(j)] * zeta[base + static_cast<std::size_t>(j)];
-  return v;
+  return weighted_vector_sum(0, d.order, [&](int j) { return d.weights[static_cast<std::size_t>(j)]; },
+                             zeta.subspan(zeta.size() - static_cast<std::size_t>(d.order)));
 }
+
+// How many of the newest kRecentNoiseSamples lengths a history's bits mark, by table (std::popcount
+// is a library call on the baseline x86-64 the build targets).
+static_assert(MotionNoiseEstimator::kRecentNoiseSamples <= 12, "a table of 2^kRecentNoiseSamples counts");
+constexpr auto kNewestMarked = [] {
+  std::array<std::uint8_t, 1u << MotionNoiseEstimator::kRecentNoiseSamples> counts{};
+  for (std::uint32_t bits = 0; bits < counts.size(); ++bits) counts[bits] = static_cast<std::uint8_t>(std::popcount(bits));
+  return counts;
+}();
 
 }  // namespace
 
@@ -123,7 +130,6 @@ MotionNoiseEstimator::MotionNoiseEstimator(int capacity, int order)
 
 void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& settings, int window) {
   settings_ = settings;
-  decay_dt_ = 0.0;  // motion_time_s may have changed
   const int m = order_;
   // The span is motion_span_s at the stream's rate, but never fewer than the m + 1 samples that
   // determine a degree-m polynomial (then the fit is the plain m-th difference). At a low rate
@@ -159,20 +165,20 @@ void MotionNoiseEstimator::configure(double rate_hz, const AdaptationSettings& s
   high_ = high_order > 0 ? noise_difference(high_order) : NoiseDifference{};
 }
 
-void MotionNoiseEstimator::update_median(Estimates::LengthMedian& m, double length, double dt) const {
+void MotionNoiseEstimator::update_median(Estimates::LengthMedian& m, double length, double dt) {
   length = std::max(length, 1e-300);
   if (!m.settled()) {
     // Exact median of the first values: a sound start for the tracker below.
     m.first_lengths[static_cast<std::size_t>(m.count++)] = length;
     std::array<double, 15> sorted = m.first_lengths;
-    m.log_median = std::log(upper_median(std::span(sorted).first(static_cast<std::size_t>(m.count))));
-    m.median = std::exp(m.log_median);
+    m.median = upper_median(std::span(sorted).first(static_cast<std::size_t>(m.count)));
   } else {
     // Stochastic approximation of the median in log space: a step up when above, down when
     // below; its time constant is about 1/(2·step) samples. A long run on one side, or a short one
     // far from it, is a noise that changed its level: the step doubles with each length beyond
-    // (kNoiseRunSamples, kNoiseFarSamples). Each length is compared with the median itself, kept
-    // beside its log (a logarithm per sample less).
+    // (kNoiseRunSamples, kNoiseFarSamples). The median is kept as itself, each length compared
+    // with it, and moved by the factor e^(±step) (RepeatedExp: the step is nearly always the last
+    // one's).
     const bool above = length > m.median;
     m.run = above ? std::max(m.run, 0) + 1 : std::min(m.run, 0) - 1;
     const bool far_above = length > kNoiseFarFactor * m.median, far_below = kNoiseFarFactor * length < m.median;
@@ -184,13 +190,12 @@ void MotionNoiseEstimator::update_median(Estimates::LengthMedian& m, double leng
     // Risen where most of the newest lengths stand far above the median, and while most stand
     // above it: the median catching up on a burst (within a second) is not the burst's end.
     const std::uint32_t newest = (1u << kRecentNoiseSamples) - 1u;
-    const auto most = [](std::uint32_t bits) { return 2 * std::popcount(bits) > kRecentNoiseSamples; };
+    const auto most = [](std::uint32_t bits) { return 2 * kNewestMarked[bits] > kRecentNoiseSamples; };
     m.risen = most(m.recent_far & newest) || (m.risen && most(m.recent_above & newest));
     double step = std::min(0.5, 0.5 * dt / settings_.noise_time_s);
     const int beyond = std::max(std::abs(m.run) - kNoiseRunSamples, std::abs(m.far_run) - kNoiseFarSamples);
     if (beyond > 0) step = std::max(step, std::min(kNoiseRunStepCap, std::ldexp(step, std::min(beyond, 60))));
-    m.log_median += above ? step : -step;
-    m.median = std::exp(m.log_median);
+    m.median *= above ? median_up_(step) : median_down_(-step);
   }
 }
 
@@ -295,7 +300,7 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
       const Vec3 d = weighted_vector_sum(0, span_ - 1, [&](int j) { return fit_[static_cast<std::size_t>(j)]; },
                                          zeta.subspan(static_cast<std::size_t>(n1 - (span_ - 1))));
       double sample = d.squaredNorm() / 3.0;
-      const double alpha = e_.motion_ready ? 1.0 - std::exp(-e_.motion_pending_s / settings_.motion_time_s) : 1.0;
+      const double alpha = e_.motion_ready ? 1.0 - motion_decay_(-e_.motion_pending_s / settings_.motion_time_s) : 1.0;
       // The fast part's fit on the newest half span and on the half before it, the smaller of
       // the two: an outlier sits in one of them, a shake in both.
       auto half_fit = [&](int back) {
@@ -449,11 +454,7 @@ MotionNoiseEstimator::StoppedMotion MotionNoiseEstimator::stopped_motion(int win
 
 void MotionNoiseEstimator::note_correction(double mean_square, double correction_gain, double bias, double dt) {
   if (e_.bias_motion > 0.0 && dt > 0.0) {
-    if (dt != decay_dt_) {  // the stream's step, nearly always the last one's
-      decay_dt_ = dt;
-      decay_ = std::exp(-dt / settings_.motion_time_s);
-    }
-    e_.bias_motion *= decay_;
+    e_.bias_motion *= bias_decay_(-dt / settings_.motion_time_s);
     // Gone where it can no longer count (and before it decays into subnormal numbers).
     if (e_.bias_motion < 1e-6 * e_.noise_var * fit_noise_gain_) e_.bias_motion = 0.0;
   }

@@ -85,8 +85,7 @@ class OutlierGuard {
   std::array<Vec3, kOutlierFitPoints - 1> increment_{};
   int head_ = 0;
   int count_ = 0;
-  double log_median_ = 0.0;
-  double median_ = 1.0;  // exp(log_median_)
+  double median_ = 1.0;  // tracked by factors e^(±kRate): a step in log space
   int seen_ = 0;  // distances seen, up to kOutlierWarmUp
   bool ordinary_before_ = false;  // the sample before landed within kOrdinary times the median
   Vec3 held_offset_ = Vec3::Zero();  // the newest held sample's measurement from the prediction

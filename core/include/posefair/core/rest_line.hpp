@@ -16,6 +16,7 @@
 #include <array>
 #include <optional>
 
+#include "posefair/core/repeated_exp.hpp"
 #include "posefair/core/so3.hpp"
 
 namespace posefair {
@@ -77,6 +78,7 @@ class RestLine {
   std::array<double, 5> squares_{};  // Σ w²·a^k: the noise the fits' weights carry
   std::array<Vec3, 3> values_{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};  // Σ w·a^k·y, k = 0..2
   int steps_ = 0;  // steps of positive length taken, up to 2
+  RepeatedExp decay_;  // e^(−dt/memory) per step
 };
 
 }  // namespace posefair

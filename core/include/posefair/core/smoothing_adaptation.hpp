@@ -37,6 +37,7 @@
 #include <span>
 #include <vector>
 
+#include "posefair/core/repeated_exp.hpp"
 #include "posefair/core/smoother_rows.hpp"
 #include "posefair/core/so3.hpp"
 
@@ -256,8 +257,7 @@ class MotionNoiseEstimator {
     struct LengthMedian {
       std::array<double, 15> first_lengths{};
       int count = 0;
-      double log_median = 0.0;
-      double median = 1.0;  // exp(log_median), kept with it: the lengths are compared with it
+      double median = 1.0;  // tracked by factors e^(±step): a step in log space
       int run = 0;  // lengths in a row above the median (> 0) or below it (< 0)
       int far_run = 0;  // lengths in a row kNoiseFarFactor times above it (> 0) or below (< 0)
       std::uint32_t recent_far = 0;    // bit i: the (i + 1)-th newest length stood kNoiseFarFactor times above it
@@ -335,7 +335,7 @@ class MotionNoiseEstimator {
   // half, kStillSlopeFactor), within its noise when the rule fired, and the samples since.
   int samples_clear_of_stop() const { return e_.stop_clear - 1 + e_.samples_since_stop; }
   // Takes a length ‖D^kθ‖ into the tracker of its order's median.
-  void update_median(Estimates::LengthMedian& m, double length, double dt) const;
+  void update_median(Estimates::LengthMedian& m, double length, double dt);
   // The least motion assumed while moving: the noise the fit lets through, or less where the
   // window's fit sees the motion is smaller.
   double motion_floor(double fit_noise) const;
@@ -353,7 +353,9 @@ class MotionNoiseEstimator {
   std::vector<double> fit_;      // weights on the span's span−1 differences
   double fit_noise_gain_ = 0.0;  // Σ of the fit's squared weights on θ
   double peak_half_s_ = 0.0;     // half the fit's span (s): the blocks of Estimates::peak
-  double decay_dt_ = 0.0, decay_ = 1.0;  // Estimates::bias_motion's factor per step, for the last step
+  // Factors per step: Estimates::bias_motion's, the motion averages' between fits, and the
+  // medians' up and down (update_median).
+  RepeatedExp bias_decay_, motion_decay_, median_up_, median_down_;
   // The motion's fast part: the same fit over half the span (0: none), and its noise gain.
   int short_span_ = 0;
   std::vector<double> short_fit_;
