@@ -424,7 +424,7 @@ void FairingWindow::adapt(Channel& ch, std::span<const Vec3> zeta, double dt) {
   const double f = ch.level - i;
   const double a = levels_[static_cast<std::size_t>(i)].mu;
   const double b = i + 1 < level_count_ ? levels_[static_cast<std::size_t>(i + 1)].mu : a;
-  ch.mu = a > 0.0 ? a * std::pow(b / a, f) : f * b;
+  ch.mu = f == 0.0 ? a : a > 0.0 ? a * std::pow(b / a, f) : f * b;  // (a whole level, at rest the heaviest: no pow)
 }
 
 // The check by the next measurement (prediction_check.hpp): at lag 0, where the adaptation's

@@ -54,7 +54,7 @@ std::optional<Eigen::Matrix3d> inverse_moments(const std::array<double, 5>& s) {
   adj(2, 2) = a * c - b * b;
   const double det = a * adj(0, 0) + b * adj(0, 1) + c * adj(0, 2);
   if (!(std::abs(det) > 0.0)) return std::nullopt;
-  const Eigen::Matrix3d inverse = adj / det;
+  const Eigen::Matrix3d inverse = adj * (1.0 / det);  // (one division, not nine)
   const Eigen::Matrix3d m = moments(s, 3);
   const double rcond = 1.0 / (m.cwiseAbs().colwise().sum().maxCoeff() * inverse.cwiseAbs().colwise().sum().maxCoeff());
   if (!(rcond > 1e-12)) return std::nullopt;
@@ -93,7 +93,8 @@ std::optional<std::array<double, 2>> RestLine::line_weights(double age) const {
   const double w0 = weights_[0], w1 = weights_[1], w2 = weights_[2];
   const double det = w0 * w2 - w1 * w1;
   if (!(det > 1e-12 * w0 * w2)) return std::nullopt;
-  return std::array<double, 2>{(w2 - w1 * age) / det, (w0 * age - w1) / det};
+  const double inverse = 1.0 / det;
+  return std::array<double, 2>{(w2 - w1 * age) * inverse, (w0 * age - w1) * inverse};
 }
 
 std::optional<Vec3> RestLine::line_at(double age) const {

@@ -5,17 +5,18 @@
 namespace posefair::so3 {
 
 Quat exp(const Vec3& v) {
-  const double theta = v.norm();
   // sin(θ)/θ and cos θ. Below 0.1 their series to θ⁸ and θ¹⁰ are exact in double precision (the
   // first terms left out, θ¹⁰/11! and θ¹²/12!, are under 3·10⁻¹⁸) at a fraction of sin's and cos's
-  // cost: nearly every step and correction of a stream is that small. (0/0 is avoided too.)
-  const double t2 = theta * theta;
-  if (theta < 0.1) {
+  // cost, and need only θ², no square root: nearly every step and correction of a stream is that
+  // small. (0/0 is avoided too.)
+  const double t2 = v.squaredNorm();
+  if (t2 < 0.01) {
     const double sinc = 1.0 + t2 * (-1.0 / 6.0 + t2 * (1.0 / 120.0 + t2 * (-1.0 / 5040.0 + t2 * (1.0 / 362880.0))));
     const double cosine =
         1.0 + t2 * (-1.0 / 2.0 + t2 * (1.0 / 24.0 + t2 * (-1.0 / 720.0 + t2 * (1.0 / 40320.0 + t2 * (-1.0 / 3628800.0)))));
     return Quat(cosine, sinc * v.x(), sinc * v.y(), sinc * v.z());
   }
+  const double theta = std::sqrt(t2);
   const double sinc = std::sin(theta) / theta;
   return Quat(std::cos(theta), sinc * v.x(), sinc * v.y(), sinc * v.z());
 }
@@ -24,20 +25,21 @@ Vec3 log(const Quat& q_in) {
   // Choose the hemisphere w >= 0 so the result is the shorter rotation.
   const Quat q = q_in.w() < 0.0 ? Quat(-q_in.coeffs()) : q_in;
   const Vec3 v = q.vec();
-  const double s = v.norm();
+  const double s2 = v.squaredNorm();
   const double w = q.w();
   // θ = atan2(s, w) is well conditioned everywhere, including near θ = pi/2 (w -> 0).
   // For small s use atan(x)/x = 1 − x²/3 + x⁴/5 − … − x¹⁴/15 with x = s/w (w ≈ |q| there): it
   // avoids 0/0, and under x = 0.1 the first term left out (x¹⁶/17, 6·10⁻¹⁸) is below a double's
   // rounding, so it is exact where nearly all samples' steps and corrections lie, at a fraction
-  // of atan2's cost.
+  // of atan2's cost (and from s², with one division and no square root).
   double scale;
-  if (s < 0.1 * w) {
-    const double x = s / w;
-    const double x2 = x * x;
+  if (s2 < 0.01 * w * w) {
+    const double inverse_w = 1.0 / w;
+    const double x2 = s2 * inverse_w * inverse_w;
     scale = (1.0 + x2 * (-1.0 / 3.0 + x2 * (1.0 / 5.0 + x2 * (-1.0 / 7.0 + x2 * (1.0 / 9.0 + x2 * (-1.0 / 11.0 +
-            x2 * (1.0 / 13.0 + x2 * (-1.0 / 15.0)))))))) / w;
+            x2 * (1.0 / 13.0 + x2 * (-1.0 / 15.0)))))))) * inverse_w;
   } else {
+    const double s = std::sqrt(s2);
     scale = std::atan2(s, w) / s;
   }
   return scale * v;
