@@ -850,10 +850,14 @@ FairingWindow::RestPart FairingWindow::rest_part(Channel& ch, int k, double dt) 
   ch.rest.averaged = false;
   // The line's ages count from the last sample it took (the newest, unless that one was off it).
   const double age = ch.rest.time - samples_[static_cast<std::size_t>(k)].time - config_.horizon_s;
+  // A motion the estimate reads at rest keeps the line out until a fit reads none. Not while the
+  // window fills again after a gap: no fit comes until it is full, so the estimate is the last
+  // one before the gap (now and then a chance reading of the noise, which then held the line off
+  // for the whole fill), and the rest goes on only while the samples stay on the line
+  // (follow_rest), which is the test that counts then.
+  const bool moving = ch.estimator.motion_variance() > 0.0 && n_ == w_;
   const std::optional<RestLine::Value> value =
-      ch.rest.resting && ch.estimator.motion_variance() == 0.0
-          ? ch.rest.line.value_at(age, ch.estimator.rest_noise_variance(), kRestLineFactor)
-          : std::nullopt;
+      ch.rest.resting && !moving ? ch.rest.line.value_at(age, ch.estimator.rest_noise_variance(), kRestLineFactor) : std::nullopt;
   if (!value) {
     ch.rest.weight = 0.0;
     return {};
