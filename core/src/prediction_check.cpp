@@ -5,8 +5,6 @@
 
 namespace posefair {
 
-
-
 void PredictionCheck::configure(double evaluations_per_second, bool lightest_first) {
   alpha_ = evaluations_per_second > 0.0 ? 1.0 - std::exp(-1.0 / (kTime * evaluations_per_second)) : 1.0;
   lightest_first_ = lightest_first;
