@@ -859,7 +859,10 @@ FairingWindow::RestPart FairingWindow::rest_part(Channel& ch, int k, double dt) 
   const std::optional<RestLine::Value> value =
       ch.rest.resting && !moving ? ch.rest.line.value_at(age, ch.estimator.rest_noise_variance(), kRestLineFactor) : std::nullopt;
   if (!value) {
-    ch.rest.weight = 0.0;
+    // The output takes the window's at once, but the line's weight is given up only where the
+    // motion is read twice running: at rest a single fit reads the noise as a motion now and then,
+    // and the weight took 0.7 s to come back (docs/engine.md, "At rest").
+    if (!(ch.rest.resting && moving && !ch.estimator.motion_read_twice_at_rest())) ch.rest.weight = 0.0;
     return {};
   }
   ch.rest.averaged = value->straight;

@@ -441,6 +441,10 @@ bool MotionNoiseEstimator::update(std::span<const Vec3> zeta, double dt, std::sp
     const double fast_noise = (e_.at_rest ? e_.rest_noise_var : e_.noise_var) * short_fit_noise_gain_;
     if (short_span_ > 0 && e_.short_mean_square > kFastMotionFactor * fast_noise)
       e_.motion_var = std::max(e_.motion_var, e_.short_mean_square - short_noise);
+    if (refreshed) {
+      e_.rest_motion_read_before = e_.rest_motion_read;
+      e_.rest_motion_read = e_.at_rest && e_.motion_var > 0.0;
+    }
   }
   return refreshed || ready() != was_ready;
 }

@@ -288,6 +288,8 @@ class MotionNoiseEstimator {
     double bias_motion = 0.0;  // d² implied by corrections over kBiasFactor times their noise, decaying
     double bias_last = 0.0;    // the last correction's implied d² (0: within that)
     bool at_rest = false;
+    // The last fit at rest read a motion, and the one before it (motion_read_twice_at_rest).
+    bool rest_motion_read = false, rest_motion_read_before = false;
     bool onset_over = false;  // the last fit stood over the onset threshold
     double onset_last = 0.0;  // the last fit's mean square
     bool stop_last = false;   // the last fit stood within its noise after a clear motion
@@ -320,6 +322,9 @@ class MotionNoiseEstimator {
   };
   StoppedMotion stopped_motion(int window) const;
   bool at_rest() const { return e_.at_rest; }
+  // The last two fits at rest read a motion (twice running, as the onset rule takes one): a single
+  // fit reads the noise as one now and then.
+  bool motion_read_twice_at_rest() const { return e_.rest_motion_read && e_.rest_motion_read_before; }
   // How many of the newest samples the rest test's line spans: the window's, or after a motion
   // stopped those clear of it. A rest line begun now takes these.
   int rest_span() const { return e_.line_clear > 0 ? e_.line_clear : line_span_; }
