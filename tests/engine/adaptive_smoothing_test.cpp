@@ -662,7 +662,7 @@ TEST(Adaptation, AMotionReadOnceAtRestDoesNotCostTheRestLineItsWeight) {
     for (std::size_t i = 1500; i + 700 < read.size(); ++i) {
       if (!read[i] || read[i - 1]) continue;
       std::size_t end = i;
-      while (read[end]) ++end;
+      while (end + 1 < read.size() && read[end]) ++end;
       // Read by one fit (one every 4 ms at 1 kHz), and the line straight right after (where the
       // same noise bent it, its weight goes whichever way).
       if (end - i > 4 || !straight[end]) continue;
@@ -1095,8 +1095,9 @@ TEST(Adaptation, AChanceMotionReadAtRestBeforeAGapDoesNotHoldTheRestLineOffAcros
   // window fills: the samples after the gap are tested against the rest line all the same.
   // Found on the seeds where it happens (the first fit at rest that reads a motion after 3 s),
   // and the same stream then loses 8 samples right after it: over the 0.4 s after the gap, 0.55
-  // of raw's error before (0.50, 0.51, 0.64 on seeds 2, 5, 8), 0.37 now (0.34, 0.24, 0.52; the
-  // line's weight comes back from nothing over motion_time_s, as after any motion read at rest).
+  // of raw's error before (0.50, 0.51, 0.64 on seeds 2, 5, 8), 0.37 with this alone (the line's
+  // weight then came back from nothing over 0.7 s), 0.10 now that a single reading keeps it
+  // (AMotionReadOnceAtRestDoesNotCostTheRestLineItsWeight; with that alone, 0.54).
   int found = 0;
   double error_sq = 0.0, raw_sq = 0.0;
   for (std::uint64_t seed = 1; seed <= 12 && found < 3; ++seed) {
@@ -1119,7 +1120,7 @@ TEST(Adaptation, AChanceMotionReadAtRestBeforeAGapDoesNotHoldTheRestLineOffAcros
     raw_sq += std::pow(rms_error_between(s, s.input.orientation, gap, gap + 0.4), 2);
   }
   ASSERT_GE(found, 3) << "a motion read at rest by chance, on 3 of 12 seeds";
-  EXPECT_LT(std::sqrt(error_sq / raw_sq), 0.45);
+  EXPECT_LT(std::sqrt(error_sq / raw_sq), 0.25);
 }
 
 // A stream that loses packets: about per_s times a second one or two samples (a step of two or
