@@ -1085,8 +1085,9 @@ TEST(Adaptation, ARestGoesOnAcrossAGapUnlessTheTrackerMovedInIt) {
 }
 
 TEST(Adaptation, AChanceMotionReadAtRestBeforeAGapDoesNotHoldTheRestLineOffAcrossIt) {
-  // At rest the motion estimate now and then reads the noise as a motion for a fit or two (a
-  // still stream at 120 Hz under noise of 0.002: about once in ten seconds), and the output
+  // At rest the motion estimate now and then reads the noise as a motion for a fit or two (still
+  // streams at 120 Hz under noise of 0.002: about once a minute under Gaussian noise, once in ten
+  // seconds under the offsets of uniform length `posefair bench streams` has), and the output
   // takes the window's smoothing until the next fit reads none. Where a gap follows at once, no
   // fit comes until the window has filled again (0.25 s after it), and the rest line, which goes on
   // across the gap, was kept off the output all that while: the error over the 0.4 s after the
